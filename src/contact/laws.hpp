@@ -1,0 +1,111 @@
+#pragma once
+// Contact laws as pure functions of explicit inputs (PHYSICS.md B). One law serves particle-particle and
+// particle-wall contacts: a wall is a partner of infinite mass and radius (m_eff = m, R_eff = a).
+#include <cmath>
+
+#include "core/vec.hpp"
+
+namespace haet {
+
+/// Coefficients of one material pair, precomputed once at set-up. Only the members of the chosen laws are used.
+struct PairCoeffs {
+    // Linear spring-dashpot (B.2): k_n = knConst + knPerMeff * m_eff, gamma_n = gnPerMeff * m_eff.
+    // (e, t_c) gives knPerMeff = (pi^2 + ln^2 e)/t_c^2 and gnPerMeff = -2 ln(e)/t_c, so every pair, whatever
+    // its masses, has the requested e and t_c. A fixed kn (LAMMPS style) goes into knConst.
+    double knConst = 0;    ///< [N/m]
+    double knPerMeff = 0;  ///< [1/s^2]
+    double gnPerMeff = 0;  ///< [1/s]
+    // Hertz (B.3): F_el = hertzK sqrt(R_eff) delta^{3/2}, hertzK = (4/3) E_eff.
+    double hertzK = 0;     ///< [Pa]
+    double dissipationTime = 0;  ///< viscoelastic A* [s]: F_d = A* hertzK sqrt(R_eff delta) delta_dot
+    double tsujiAlpha = 0;       ///< Tsuji: F_d = alpha sqrt(2 m_eff k_H) delta^{1/4} delta_dot (B.3 pitfall)
+    // Tangential (B.4)
+    double ktRatio = 0;    ///< k_t / k_n [-] (used when ktConst == 0)
+    double ktConst = 0;    ///< fixed k_t [N/m]
+    double gtPerMeff = 0;  ///< gamma_t / m_eff [1/s]
+    double mu = 0;         ///< Coulomb friction [-]
+    // Collision-operator view of the same pair (event-driven engine, PHYSICS.md A.1, C)
+    double restitution = 1;  ///< e that the soft law produces (incl. the contact-ending rule)
+    double beta0 = 1;        ///< Walton's sticking tangential restitution
+};
+
+/// Normal force magnitude and the contact's secant stiffness (for the tangential spring).
+struct NormalResult {
+    double fn;  ///< normal force on i along n [N]; clipped at 0 unless attraction is allowed
+    double k;   ///< secant stiffness F_el/delta [N/m]
+};
+
+/// Linear spring-dashpot, F = k_n delta + gamma_n delta_dot (B.2). deltaDot = -g_n [m/s].
+struct LinearNormal {
+    static NormalResult eval(const PairCoeffs& c, double delta, double deltaDot, double meff, double /*reff*/) {
+        const double kn = c.knConst + c.knPerMeff * meff;
+        return {kn * delta + c.gnPerMeff * meff * deltaDot, kn};
+    }
+};
+
+/// Hertz with viscoelastic damping (Brilliantov et al. 1996; B.3): F = rho delta^{3/2} + A* rho sqrt(delta) delta_dot.
+struct HertzViscoNormal {
+    static NormalResult eval(const PairCoeffs& c, double delta, double deltaDot, double /*meff*/, double reff) {
+        const double k = c.hertzK * std::sqrt(reff * delta);  // secant stiffness rho sqrt(delta)
+        return {k * (delta + c.dissipationTime * deltaDot), k};
+    }
+};
+
+/// Hertz with Tsuji damping: F = k_H delta^{3/2} + alpha sqrt(2 m_eff k_H) delta^{1/4} delta_dot, k_H = hertzK sqrt(R).
+/// The mass in the damping is 2 m_eff: Tsuji's alpha(e) fit assumes the particle mass (PHYSICS.md B.3 pitfall).
+struct HertzTsujiNormal {
+    static NormalResult eval(const PairCoeffs& c, double delta, double deltaDot, double meff, double reff) {
+        const double kH = c.hertzK * std::sqrt(reff);
+        const double sd = std::sqrt(delta);
+        const double damp = c.tsujiAlpha * std::sqrt(2.0 * meff * kH) * std::sqrt(sd);
+        return {kH * delta * sd + damp * deltaDot, kH * sd};
+    }
+};
+
+/// Tsuji's polynomial alpha(e) for the damping coefficient (LAMMPS pair_granular docs).
+inline double tsujiAlpha(double e) {
+    return 1.2728 - 4.2783 * e + 11.087 * e * e - 22.348 * e * e * e + 27.467 * std::pow(e, 4) -
+           18.022 * std::pow(e, 5) + 4.8218 * std::pow(e, 6);
+}
+
+/// No tangential force.
+struct NoTangential {
+    static constexpr bool kHasHistory = false;
+    template <int D>
+    static Vec<D> eval(const PairCoeffs&, double, double, double, const Vec<D>&, const Vec<D>&, const Vec<D>&,
+                       Vec<D>&, double) {
+        return Vec<D>::zero();
+    }
+};
+
+/// Cundall-Strack tangential spring with Coulomb limit and history (B.4).
+/// xi: the spring elongation [m], kept per contact; gt: tangential relative velocity of the contact points
+/// (for the damping); gStep: its mean over the last step, so that xi grows by the true relative displacement.
+struct SpringTangential {
+    static constexpr bool kHasHistory = true;
+    template <int D>
+    static Vec<D> eval(const PairCoeffs& c, double fn, double kNormal, double meff, const Vec<D>& n,
+                       const Vec<D>& gt, const Vec<D>& gStep, Vec<D>& xi, double dt) {
+        // The contact plane turns with the pair: project xi onto it and keep its length (Luding 2008).
+        const double len2 = norm2(xi);
+        if (len2 > 0) {
+            xi -= n * dot(n, xi);
+            const double l2new = norm2(xi);
+            if (l2new > 0) xi *= std::sqrt(len2 / l2new);
+        }
+        xi += gStep * dt;
+        const double kt = c.ktConst > 0 ? c.ktConst : c.ktRatio * kNormal;
+        const double gammaT = c.gtPerMeff * meff;
+        Vec<D> ft = xi * (-kt) - gt * gammaT;
+        const double ft2 = norm2(ft);
+        const double fmax = c.mu * fn;
+        if (ft2 > fmax * fmax) {
+            // Sliding: the force sits on the Coulomb cone and the spring is shortened to match it.
+            ft *= fmax / std::sqrt(ft2);
+            if (kt > 0) xi = (ft + gt * gammaT) * (-1.0 / kt);
+        }
+        return ft;
+    }
+};
+
+}  // namespace haet

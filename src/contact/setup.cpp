@@ -1,0 +1,205 @@
+#include "contact/setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace haet {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double normalForce(NormalLaw law, HertzDamping damping, const PairCoeffs& c, double delta, double ddot, double meff,
+                   double reff) {
+    if (law == NormalLaw::Linear) return LinearNormal::eval(c, delta, ddot, meff, reff).fn;
+    if (delta <= 0) return 0;
+    switch (damping) {
+        case HertzDamping::Tsuji: return HertzTsujiNormal::eval(c, delta, ddot, meff, reff).fn;
+        case HertzDamping::Viscoelastic: return HertzViscoNormal::eval(c, delta, ddot, meff, reff).fn;
+        case HertzDamping::None: break;
+    }
+    return c.hertzK * std::sqrt(reff) * delta * std::sqrt(delta);
+}
+
+/// Solves for the viscoelastic A* that gives restitution e at impact speed v (bisection; e falls with A*).
+double solveDissipationTime(const PairCoeffs& base, double e, double meff, double reff, double v, bool attraction) {
+    if (e >= 1) return 0;
+    PairCoeffs c = base;
+    // Scale: the elastic contact time bounds any sensible A*.
+    const double eEff = 0.75 * c.hertzK;
+    const double tc = 2.868 * std::pow(meff * meff / (reff * eEff * eEff * v), 0.2);
+    double lo = 0, hi = tc;
+    for (;;) {  // grow hi until it dissipates enough
+        c.dissipationTime = hi;
+        if (simulateHeadOn(NormalLaw::Hertz, HertzDamping::Viscoelastic, c, meff, reff, v, attraction).restitution < e)
+            break;
+        hi *= 2;
+        if (hi > 1e6 * tc) return hi;
+    }
+    for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        c.dissipationTime = mid;
+        const double em =
+            simulateHeadOn(NormalLaw::Hertz, HertzDamping::Viscoelastic, c, meff, reff, v, attraction).restitution;
+        (em > e ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+HeadOnResult simulateHeadOn(NormalLaw law, HertzDamping damping, const PairCoeffs& c, double meff, double reff,
+                            double v, bool attraction) {
+    // Overlap equation m_eff delta'' = -F(delta, delta'), delta(0) = 0, delta'(0) = v.
+    // Step from the elastic estimate of the contact time.
+    double tEst;
+    if (law == NormalLaw::Linear) {
+        const double kn = c.knConst + c.knPerMeff * meff;
+        tEst = kPi * std::sqrt(meff / kn);
+    } else {
+        const double eEff = 0.75 * c.hertzK;
+        tEst = 2.868 * std::pow(meff * meff / (reff * eEff * eEff * v), 0.2);
+    }
+    const double h = tEst / 20000.0;
+    auto acc = [&](double d, double dd) { return -normalForce(law, damping, c, d, dd, meff, reff) / meff; };
+    double d = 0, dd = v, t = 0, dmax = 0;
+    for (long step = 0; step < 10000000; ++step) {
+        const double k1x = dd, k1v = acc(d, dd);
+        const double k2x = dd + 0.5 * h * k1v, k2v = acc(d + 0.5 * h * k1x, dd + 0.5 * h * k1v);
+        const double k3x = dd + 0.5 * h * k2v, k3v = acc(d + 0.5 * h * k2x, dd + 0.5 * h * k2v);
+        const double k4x = dd + h * k3v, k4v = acc(d + h * k3x, dd + h * k3v);
+        const double dn = d + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+        const double ddn = dd + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+        dmax = std::max(dmax, dn);
+        if (dn <= 0) {  // overlap returned to zero: interpolate the crossing linearly
+            const double frac = d / (d - dn);
+            return {-(dd + frac * (ddn - dd)) / v, t + frac * h, dmax};
+        }
+        if (!attraction && step > 0) {
+            const double fOld = normalForce(law, damping, c, d, dd, meff, reff);
+            const double fNew = normalForce(law, damping, c, dn, ddn, meff, reff);
+            if (fNew <= 0 && ddn < 0) {  // force would turn attractive: the particles separate here
+                const double frac = fOld / (fOld - fNew);
+                return {-(dd + frac * (ddn - dd)) / v, t + frac * h, dmax};
+            }
+        }
+        d = dn;
+        dd = ddn;
+        t += h;
+    }
+    return {std::numeric_limits<double>::quiet_NaN(), t, dmax};
+}
+
+ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialStats>& stats) {
+    ContactSetup s;
+    const ContactDef& cd = sc.contact;
+    s.normal = cd.normal;
+    s.hertzDamping = cd.normal == NormalLaw::Hertz ? cd.hertzDamping : HertzDamping::None;
+    s.tangential = cd.tangential;
+    s.attraction = cd.attraction;
+    const int nm = static_cast<int>(sc.materials.size());
+    s.nMaterials = nm;
+    s.table.resize(nm * nm);
+    const double q = sc.dimension == 2 ? 0.5 : 0.4;
+
+    // Reference particle of each material (materials without particles borrow the overall mean).
+    MaterialStats all;
+    for (const auto& st : stats) {
+        if (st.count == 0) continue;
+        all.meanRadius += st.meanRadius * st.count;
+        all.meanMass += st.meanMass * st.count;
+        all.count += st.count;
+        all.minRadius = all.minRadius == 0 ? st.minRadius : std::min(all.minRadius, st.minRadius);
+        all.minMass = all.minMass == 0 ? st.minMass : std::min(all.minMass, st.minMass);
+    }
+    if (all.count > 0) {
+        all.meanRadius /= all.count;
+        all.meanMass /= all.count;
+    } else {
+        all.meanRadius = all.minRadius = 1;
+        all.meanMass = all.minMass = 1;
+    }
+    auto ref = [&](int m) { return (m < (int)stats.size() && stats[m].count > 0) ? stats[m] : all; };
+
+    for (int a = 0; a < nm; ++a) {
+        for (int b = 0; b < nm; ++b) {
+            const MaterialDef& ma = sc.materials[a];
+            const MaterialDef& mb = sc.materials[b];
+            PairCoeffs c;
+            const double e = std::sqrt(ma.restitution * mb.restitution);
+            c.mu = std::sqrt(ma.friction * mb.friction);
+            c.beta0 = 0.5 * (ma.tangentialRestitution + mb.tangentialRestitution);
+            const double lne = std::log(e);
+            const MaterialStats ra = ref(a), rb = ref(b);
+            const double meffRef = ra.meanMass * rb.meanMass / (ra.meanMass + rb.meanMass);
+            const double reffRef = ra.meanRadius * rb.meanRadius / (ra.meanRadius + rb.meanRadius);
+            if (cd.normal == NormalLaw::Linear) {
+                if (cd.kn) {
+                    c.knConst = *cd.kn;
+                    if (cd.gammaN) {
+                        c.gnPerMeff = *cd.gammaN;
+                    } else {
+                        // gamma_n = -2 ln(e) sqrt(m_eff k_n / (pi^2 + ln^2 e)): exact for the reference pair
+                        c.gnPerMeff = -2 * lne * std::sqrt(*cd.kn / (meffRef * (kPi * kPi + lne * lne)));
+                    }
+                } else {
+                    const double tc = *cd.duration;
+                    c.knPerMeff = (kPi * kPi + lne * lne) / (tc * tc);
+                    c.gnPerMeff = -2 * lne / tc;
+                }
+            } else {
+                const double ea = (1 - ma.poisson * ma.poisson) / ma.young;
+                const double eb = (1 - mb.poisson * mb.poisson) / mb.young;
+                c.hertzK = (4.0 / 3.0) / (ea + eb);
+                if (cd.hertzDamping == HertzDamping::Tsuji) {
+                    c.tsujiAlpha = tsujiAlpha(e);
+                } else if (cd.hertzDamping == HertzDamping::Viscoelastic) {
+                    if (ma.dissipationTime && mb.dissipationTime)
+                        c.dissipationTime = 0.5 * (*ma.dissipationTime + *mb.dissipationTime);
+                    else
+                        c.dissipationTime =
+                            solveDissipationTime(c, e, meffRef, reffRef, cd.impactVelocity, cd.attraction);
+                }
+            }
+            if (cd.tangential == TangentialLaw::Spring) {
+                if (cd.kt)
+                    c.ktConst = *cd.kt;
+                else
+                    c.ktRatio = cd.ktRatio ? *cd.ktRatio : q / (1 + q);
+                c.gtPerMeff = cd.gammaT;
+            }
+            // The restitution the soft law really produces (contact-ending rule included), for the EDM.
+            c.restitution = simulateHeadOn(s.normal, s.hertzDamping, c, meffRef, reffRef, cd.impactVelocity,
+                                           cd.attraction)
+                                .restitution;
+            s.table[a * nm + b] = c;
+        }
+    }
+
+    // Contact time for the time-step rule: the lightest pair (two smallest particles), and a wall contact.
+    const double meffMin = 0.5 * all.minMass;
+    const double reffMin = 0.5 * all.minRadius;
+    double tc = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < nm; ++a)
+        for (int b = 0; b < nm; ++b) {
+            const PairCoeffs& c = s.table[a * nm + b];
+            if (cd.normal == NormalLaw::Linear) {
+                const double kn = c.knConst + c.knPerMeff * meffMin;
+                const double eta = 0.5 * c.gnPerMeff;
+                const double w2 = kn / meffMin - eta * eta;
+                tc = std::min(tc, w2 > 0 ? kPi / std::sqrt(w2) : kPi * std::sqrt(meffMin / kn));
+            } else {
+                const double eEff = 0.75 * c.hertzK;
+                tc = std::min(tc, 2.868 * std::pow(meffMin * meffMin / (reffMin * eEff * eEff * cd.impactVelocity), 0.2));
+            }
+        }
+    s.contactTime = tc;
+    if (cd.normal == NormalLaw::Linear)
+        s.contactTimeNote = cd.kn ? "linear law, fixed k_n: t_c = pi/omega of the lightest pair"
+                                  : "linear law: t_c as given";
+    else
+        s.contactTimeNote = "Hertz: t_c = 2.868 (m_eff^2/(R_eff E_eff^2 v))^(1/5) of the smallest pair at impact_velocity";
+    return s;
+}
+
+}  // namespace haet

@@ -1,0 +1,49 @@
+#pragma once
+// Turns the user's materials and [contact] section into per-material-pair coefficients (PairCoeffs),
+// once, before the run. Mixing rules (documented in docs/scenario.md):
+//   E_eff = [(1-nu_a^2)/E_a + (1-nu_b^2)/E_b]^-1 (Hertz), e_ab = sqrt(e_a e_b), mu_ab = sqrt(mu_a mu_b),
+//   beta0_ab = (beta0_a + beta0_b)/2, A*_ab = (A*_a + A*_b)/2.
+#include <string>
+#include <vector>
+
+#include "contact/laws.hpp"
+#include "scenario/definition.hpp"
+
+namespace haet {
+
+/// Sizes of the particles of one material, used for reference contacts (time step, derived damping).
+struct MaterialStats {
+    std::size_t count = 0;
+    double meanRadius = 0, meanMass = 0;  ///< [m], [kg]
+    double minRadius = 0, minMass = 0;    ///< [m], [kg]
+};
+
+struct ContactSetup {
+    NormalLaw normal = NormalLaw::Linear;
+    HertzDamping hertzDamping = HertzDamping::None;
+    TangentialLaw tangential = TangentialLaw::None;
+    bool attraction = false;
+    int nMaterials = 0;
+    std::vector<PairCoeffs> table;  ///< nMaterials x nMaterials, symmetric
+    double contactTime = 0;         ///< shortest contact duration among particle pairs and walls [s]
+    std::string contactTimeNote;    ///< how contactTime was obtained (for `haet check`)
+
+    const PairCoeffs& pair(int a, int b) const { return table[a * nMaterials + b]; }
+};
+
+/// Builds the coefficient table. stats has one entry per material (count 0 for wall-only materials).
+ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialStats>& stats);
+
+/// Result of integrating one head-on collision of the soft law (PHYSICS.md B.2/B.3).
+struct HeadOnResult {
+    double restitution;  ///< -g_n after / g_n before
+    double duration;     ///< contact duration [s]
+    double maxOverlap;   ///< [m]
+};
+
+/// Integrates a head-on collision with approach speed v [m/s] accurately (RK4, ~20000 steps per contact).
+/// The contact ends when the overlap returns to zero, or (attraction = false) when the force reaches zero.
+HeadOnResult simulateHeadOn(NormalLaw law, HertzDamping damping, const PairCoeffs& c, double meff, double reff,
+                            double v, bool attraction);
+
+}  // namespace haet

@@ -1,0 +1,88 @@
+#pragma once
+// The one particle store shared by every engine: structure-of-arrays, ordered for the force loop.
+#include <cstdint>
+#include <vector>
+
+#include "core/vec.hpp"
+
+namespace haet {
+
+/// Per-particle flag bits.
+enum ParticleFlag : std::uint8_t {
+    kFrozen = 1u << 0,  ///< not integrated: position and velocity stay as given (a rough base, a fixture)
+};
+
+/// Shape factor q of the moment of inertia I = q m a^2 (PHYSICS.md B.4): solid disk 1/2, solid sphere 2/5.
+template <int D>
+inline constexpr double kInertiaFactor = (D == 2) ? 0.5 : 0.4;
+
+template <int D>
+struct Particles {
+    // hot: read or written every step
+    std::vector<Vec<D>> x;        ///< centre position [m]
+    std::vector<Vec<D>> v;        ///< velocity [m/s]
+    std::vector<Ang<D>> w;        ///< angular velocity [rad/s]
+    std::vector<Vec<D>> f;        ///< total force [N]
+    std::vector<Ang<D>> torque;   ///< total torque [N m]
+    std::vector<double> radius;   ///< [m]
+    std::vector<double> invMass;  ///< 1/m [1/kg]; 0 for a frozen particle
+    std::vector<double> invInertia;  ///< 1/I [1/(kg m^2)]; 0 for a frozen particle
+    std::vector<std::uint16_t> material;  ///< index into the material table
+    std::vector<std::uint8_t> flags;      ///< ParticleFlag bits
+    // cold
+    std::vector<double> mass;     ///< [kg] (kept for frozen particles too, for contact effective mass)
+    std::vector<Ang<D>> angle;    ///< accumulated rotation angle [rad] (2D: orientation)
+    std::vector<std::uint64_t> id;  ///< stable user-visible id (survives reordering)
+    std::vector<Vec<D>> image;    ///< accumulated periodic wraps, for unwrapped positions [m]
+
+    std::size_t size() const { return x.size(); }
+
+    /// Appends one particle of given density [kg/m^D-volume]; mass from radius and density.
+    std::size_t add(const Vec<D>& pos, const Vec<D>& vel, const Ang<D>& spin, double r, double density,
+                    std::uint16_t mat, std::uint64_t pid, std::uint8_t flag = 0) {
+        const double m = density * volumeOf(r);
+        x.push_back(pos);
+        v.push_back(vel);
+        w.push_back(spin);
+        f.push_back(Vec<D>::zero());
+        torque.push_back(Ang<D>::zero());
+        radius.push_back(r);
+        mass.push_back(m);
+        const bool frozen = flag & kFrozen;
+        invMass.push_back(frozen ? 0.0 : 1.0 / m);
+        invInertia.push_back(frozen ? 0.0 : 1.0 / (kInertiaFactor<D> * m * r * r));
+        material.push_back(mat);
+        flags.push_back(flag);
+        angle.push_back(Ang<D>::zero());
+        id.push_back(pid);
+        image.push_back(Vec<D>::zero());
+        return x.size() - 1;
+    }
+
+    /// Volume of a sphere (3D) or area of a disk (2D) of radius r.
+    static double volumeOf(double r) {
+        constexpr double pi = 3.14159265358979323846;
+        return (D == 2) ? pi * r * r : (4.0 / 3.0) * pi * r * r * r;
+    }
+
+    double inertia(std::size_t i) const { return kInertiaFactor<D> * mass[i] * radius[i] * radius[i]; }
+    bool frozen(std::size_t i) const { return flags[i] & kFrozen; }
+
+    /// Applies a permutation: new index k holds old particle order[k]. Used for spatial sorting.
+    void permute(const std::vector<std::uint32_t>& order) {
+        auto apply = [&](auto& arr) {
+            auto tmp = arr;
+            for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = arr[order[k]];
+            arr.swap(tmp);
+        };
+        apply(x); apply(v); apply(w); apply(f); apply(torque); apply(radius); apply(invMass);
+        apply(invInertia); apply(material); apply(flags); apply(mass); apply(angle); apply(id); apply(image);
+    }
+};
+
+}  // namespace haet
+
+namespace haet {
+/// Below this many particles a loop runs on one thread: fork/join would cost more than it saves.
+inline constexpr std::size_t kParallelMin = 2048;
+}  // namespace haet

@@ -1,0 +1,275 @@
+#include "neighbor/pair_list.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <omp.h>
+
+namespace haet {
+namespace {
+
+template <int D>
+struct Grid {
+    std::array<int, D> n{};
+    Vec<D> lo, width;
+    int total = 1;
+
+    Grid(const Domain<D>& dom, double cellSize) {
+        lo = dom.lo;
+        for (int k = 0; k < D; ++k) {
+            const double L = dom.hi[k] - dom.lo[k];
+            n[k] = std::max(1, static_cast<int>(std::floor(L / cellSize)));
+            // Keep the grid small for huge boxes with few particles: at most ~2^22 cells in all.
+            width[k] = L / n[k];
+            total *= n[k];
+        }
+    }
+    int coord(const Vec<D>& x, int k) const {
+        const int c = static_cast<int>(std::floor((x[k] - lo[k]) / width[k]));
+        return std::clamp(c, 0, n[k] - 1);
+    }
+    int index(const std::array<int, D>& c) const {
+        int idx = 0;
+        for (int k = D - 1; k >= 0; --k) idx = idx * n[k] + c[k];
+        return idx;
+    }
+    int cellOf(const Vec<D>& x) const {
+        std::array<int, D> c;
+        for (int k = 0; k < D; ++k) c[k] = coord(x, k);
+        return index(c);
+    }
+};
+
+/// Particles sorted by cell: cellStart (size total+1) and the particle indices in cell order.
+template <int D>
+void sortIntoCells(const Particles<D>& p, const Grid<D>& g, std::vector<std::uint32_t>& cellStart,
+                   std::vector<std::uint32_t>& members, std::vector<int>& cellOf) {
+    const std::size_t n = p.size();
+    cellOf.resize(n);
+    cellStart.assign(g.total + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        cellOf[i] = g.cellOf(p.x[i]);
+        ++cellStart[cellOf[i] + 1];
+    }
+    for (int c = 0; c < g.total; ++c) cellStart[c + 1] += cellStart[c];
+    members.resize(n);
+    std::vector<std::uint32_t> fill(cellStart.begin(), cellStart.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) members[fill[cellOf[i]]++] = static_cast<std::uint32_t>(i);
+}
+
+template <int D>
+std::vector<Vec<D>> makeShiftVectors(const Domain<D>& dom) {
+    constexpr int m = (D == 2) ? 9 : 27;
+    std::vector<Vec<D>> sv(m);
+    for (int code = 0; code < m; ++code) {
+        int c = code;
+        for (int k = 0; k < D; ++k) {
+            const int s = c % 3 - 1;
+            c /= 3;
+            sv[code][k] = s * (dom.hi[k] - dom.lo[k]);
+        }
+    }
+    return sv;
+}
+
+/// Tests pair (i, j); on success appends it with its minimum-image shift code.
+template <int D>
+inline bool testPair(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, std::uint32_t i,
+                     std::uint32_t j, std::uint8_t& code) {
+    if (s.excludeFrozenPairs && (p.flags[i] & p.flags[j] & kFrozen)) return false;
+    Vec<D> d = p.x[i] - p.x[j];
+    int cd = 0, mul = 1;
+    for (int k = 0; k < D; ++k) {
+        int sk = 0;
+        if (dom.periodic[k]) {
+            const double L = dom.hi[k] - dom.lo[k];
+            sk = -static_cast<int>(std::nearbyint(d[k] / L));
+            sk = std::clamp(sk, -1, 1);
+            d[k] += sk * L;
+        }
+        cd += (sk + 1) * mul;
+        mul *= 3;
+    }
+    const double cut = p.radius[i] + p.radius[j] + s.skin;
+    if (norm2(d) >= cut * cut) return false;
+    code = static_cast<std::uint8_t>(cd);
+    return true;
+}
+
+/// Fills first/partner/shift from per-particle candidate lists, sorts each by j, carries history, and builds
+/// the transposed index.
+template <int D>
+void finishList(std::size_t n, std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>>& cand,
+                const PairList<D>& old, PairList<D>& out) {
+    out.first.assign(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) out.first[i + 1] = out.first[i] + static_cast<std::uint32_t>(cand[i].size());
+    const std::size_t np = out.first[n];
+    out.partner.resize(np);
+    out.shift.resize(np);
+    out.history.assign(np, Vec<D>::zero());
+    const bool carry = old.first.size() == n + 1 && !old.history.empty();
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (std::size_t i = 0; i < n; ++i) {
+        auto& c = cand[i];
+        std::sort(c.begin(), c.end());
+        std::uint32_t o = out.first[i];
+        for (const auto& [j, code] : c) {
+            out.partner[o] = j;
+            out.shift[o] = code;
+            ++o;
+        }
+        if (carry) {  // merge two j-sorted lists
+            std::uint32_t a = old.first[i], ae = old.first[i + 1], b = out.first[i], be = out.first[i + 1];
+            while (a < ae && b < be) {
+                if (old.partner[a] < out.partner[b]) ++a;
+                else if (old.partner[a] > out.partner[b]) ++b;
+                else out.history[b++] = old.history[a++];
+            }
+        }
+    }
+    // Transposed index, in increasing pair order for each partner (deterministic gather order).
+    out.firstT.assign(n + 1, 0);
+    for (std::size_t k = 0; k < np; ++k) ++out.firstT[out.partner[k] + 1];
+    for (std::size_t i = 0; i < n; ++i) out.firstT[i + 1] += out.firstT[i];
+    out.pairT.resize(np);
+    std::vector<std::uint32_t> fill(out.firstT.begin(), out.firstT.end() - 1);
+    for (std::size_t k = 0; k < np; ++k) out.pairT[fill[out.partner[k]]++] = static_cast<std::uint32_t>(k);
+}
+
+}  // namespace
+
+template <int D>
+void wrapPositions(Particles<D>& p, const Domain<D>& dom) {
+    for (int k = 0; k < D; ++k) {
+        if (!dom.periodic[k]) continue;
+        const double L = dom.hi[k] - dom.lo[k];
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            double& x = p.x[i][k];
+            if (x >= dom.lo[k] && x < dom.hi[k]) continue;
+            const double s = std::floor((x - dom.lo[k]) / L);
+            x -= s * L;
+            if (x >= dom.hi[k]) x -= L;  // round-off at the upper edge
+            if (x < dom.lo[k]) x = dom.lo[k];
+            p.image[i][k] += s * L;
+        }
+    }
+}
+
+template <int D>
+void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, const PairList<D>& old,
+                   PairList<D>& out) {
+    const std::size_t n = p.size();
+    double rmax = 0;
+    for (double r : p.radius) rmax = std::max(rmax, r);
+    const Grid<D> g(dom, std::max(2 * rmax + s.skin, 1e-300));
+    std::vector<std::uint32_t> cellStart, members;
+    std::vector<int> cellOf;
+    sortIntoCells(p, g, cellStart, members, cellOf);
+    out.shiftVec = makeShiftVectors(dom);
+
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> cand(n);
+#pragma omp parallel for schedule(dynamic, 256) if (n >= kParallelMin)
+    for (std::size_t i = 0; i < n; ++i) {
+        std::array<int, D> c;
+        for (int k = 0; k < D; ++k) c[k] = g.coord(p.x[i], k);
+        // Neighbouring cells, de-duplicated (a periodic axis with fewer than 3 cells maps offsets together).
+        int cells[27];
+        int nc = 0;
+        constexpr int m = (D == 2) ? 9 : 27;
+        for (int code = 0; code < m; ++code) {
+            std::array<int, D> cc;
+            bool ok = true;
+            int t = code;
+            for (int k = 0; k < D; ++k) {
+                int ck = c[k] + (t % 3) - 1;
+                t /= 3;
+                if (ck < 0 || ck >= g.n[k]) {
+                    if (!dom.periodic[k]) { ok = false; break; }
+                    ck = (ck + g.n[k]) % g.n[k];
+                }
+                cc[k] = ck;
+            }
+            if (ok) cells[nc++] = g.index(cc);
+        }
+        std::sort(cells, cells + nc);
+        nc = static_cast<int>(std::unique(cells, cells + nc) - cells);
+        auto& ci = cand[i];
+        for (int q = 0; q < nc; ++q) {
+            for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) {
+                const std::uint32_t j = members[a];
+                if (j <= i) continue;
+                std::uint8_t code;
+                if (testPair(p, dom, s, static_cast<std::uint32_t>(i), j, code)) ci.emplace_back(j, code);
+            }
+        }
+    }
+    finishList(n, cand, old, out);
+}
+
+template <int D>
+void buildAllPairs(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, PairList<D>& out) {
+    const std::size_t n = p.size();
+    out.shiftVec = makeShiftVectors(dom);
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> cand(n);
+    for (std::uint32_t i = 0; i < n; ++i)
+        for (std::uint32_t j = i + 1; j < n; ++j) {
+            std::uint8_t code;
+            if (testPair(p, dom, s, i, j, code)) cand[i].emplace_back(j, code);
+        }
+    finishList(n, cand, PairList<D>{}, out);
+}
+
+template <int D>
+std::vector<std::uint32_t> spatialOrder(const Particles<D>& p, const Domain<D>& dom, double cellSize) {
+    const Grid<D> g(dom, cellSize);
+    std::vector<std::uint32_t> cellStart, members;
+    std::vector<int> cellOf;
+    sortIntoCells(p, g, cellStart, members, cellOf);
+    return members;
+}
+
+template <int D>
+void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order) {
+    const std::size_t n = order.size();
+    std::vector<std::uint32_t> inv(n);
+    for (std::size_t k = 0; k < n; ++k) inv[order[k]] = static_cast<std::uint32_t>(k);
+    struct Entry { std::uint32_t i, j; Vec<D> h; };
+    std::vector<Entry> kept;
+    if (list.first.size() == n + 1) {
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
+                if (list.history.empty() || norm2(list.history[k]) == 0) continue;
+                std::uint32_t a = inv[i], b = inv[list.partner[k]];
+                Vec<D> h = list.history[k];
+                if (a > b) { std::swap(a, b); h = -h; }  // xi of (j, i) is -xi of (i, j)
+                kept.push_back({a, b, h});
+            }
+    }
+    std::sort(kept.begin(), kept.end(), [](const Entry& x, const Entry& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
+    list.first.assign(n + 1, 0);
+    for (const auto& e : kept) ++list.first[e.i + 1];
+    for (std::size_t i = 0; i < n; ++i) list.first[i + 1] += list.first[i];
+    list.partner.resize(kept.size());
+    list.history.resize(kept.size());
+    list.shift.assign(kept.size(), PairList<D>::kNoShift);
+    for (std::size_t k = 0; k < kept.size(); ++k) {
+        list.partner[k] = kept[k].j;
+        list.history[k] = kept[k].h;
+    }
+    list.firstT.clear();
+    list.pairT.clear();
+}
+
+#define HAET_INSTANTIATE(D)                                                                                     \
+    template void buildPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&,              \
+                                   const PairList<D>&, PairList<D>&);                                           \
+    template void buildAllPairs<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, PairList<D>&); \
+    template void wrapPositions<D>(Particles<D>&, const Domain<D>&);                                            \
+    template std::vector<std::uint32_t> spatialOrder<D>(const Particles<D>&, const Domain<D>&, double);         \
+    template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);
+HAET_INSTANTIATE(2)
+HAET_INSTANTIATE(3)
+#undef HAET_INSTANTIATE
+
+}  // namespace haet

@@ -1,0 +1,58 @@
+#pragma once
+// Verlet pair list built from a cell grid (linked cells as cell-sorted arrays), with a skin, periodic images
+// and per-pair contact history that survives rebuilds. The all-pairs reference twin is buildAllPairs().
+//
+// Layout: a half list in CSR form. Pairs of particle i are [first[i], first[i+1]) with partners j > i, sorted
+// by j. Each pair carries an image-shift code so that r_i - r_j + shift is the minimum-image separation for as
+// long as no particle has moved more than skin/2 since the build.
+#include <cstdint>
+#include <vector>
+
+#include "core/particles.hpp"
+#include "geometry/domain.hpp"
+
+namespace haet {
+
+template <int D>
+struct PairList {
+    std::vector<std::uint32_t> first;   ///< CSR offsets, size n+1
+    std::vector<std::uint32_t> partner; ///< j of each pair
+    std::vector<std::uint8_t> shift;    ///< image-shift code of each pair, index into shiftVec
+    std::vector<Vec<D>> history;        ///< tangential spring of each pair [m]; zero when not touching
+    std::vector<Vec<D>> shiftVec;       ///< 3^D shift vectors [m]
+    // Transposed index: pairs in which particle k is the partner j, in increasing pair order.
+    std::vector<std::uint32_t> firstT;
+    std::vector<std::uint32_t> pairT;
+
+    std::size_t size() const { return partner.size(); }
+    static constexpr int kNoShift = (D == 2) ? 4 : 13;
+};
+
+struct NeighborSettings {
+    double skin = 0;               ///< [m]
+    bool excludeFrozenPairs = true;  ///< pairs of two frozen particles never matter
+};
+
+/// Builds the pair list with a cell grid. Positions must already be wrapped into the box on periodic axes.
+/// Contact history of pairs present in `old` (same particle numbering) is carried over.
+template <int D>
+void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, const PairList<D>& old,
+                   PairList<D>& out);
+
+/// The reference twin: all N(N-1)/2 pairs tested directly. Same output format (no history transfer).
+template <int D>
+void buildAllPairs(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, PairList<D>& out);
+
+/// Wraps positions into the box on periodic axes (recording the wraps in p.image).
+template <int D>
+void wrapPositions(Particles<D>& p, const Domain<D>& dom);
+
+/// Spatial order of particles (cell by cell) for memory locality; returns the permutation for Particles::permute.
+template <int D>
+std::vector<std::uint32_t> spatialOrder(const Particles<D>& p, const Domain<D>& dom, double cellSize);
+
+/// Renumbers a pair list's history after Particles::permute(order), so it can be carried into the next build.
+template <int D>
+void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order);
+
+}  // namespace haet

@@ -1,0 +1,142 @@
+#pragma once
+// Definition structs: everything a user sets in a scenario file, with defaults and units.
+// The loader (scenario/loader.cpp) fills these from TOML and validates them; nothing below the loader
+// parses strings. Vectors are stored with three components; a 2D scenario uses the first two.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace haet {
+
+using Vec3d = std::array<double, 3>;
+
+enum class Method { Tdm, Edm, Haet };
+enum class NormalLaw { Linear, Hertz };
+enum class HertzDamping { None, Viscoelastic, Tsuji };
+enum class TangentialLaw { None, Spring };
+enum class IntegratorKind { Verlet, Gear5 };
+enum class Arrangement { Lattice, Random, File };
+enum class FileFormat { Csv, LammpsData };
+
+/// Where a value came from, for error messages: file and 1-based line (0 when unknown).
+struct SourcePos {
+    std::string file;
+    int line = 0;
+};
+
+/// A scenario that cannot be run. Carries "file:line: key: what is wrong"; the CLI exits with code 2.
+class ScenarioError : public std::runtime_error {
+public:
+    ScenarioError(const SourcePos& pos, const std::string& key, const std::string& what)
+        : std::runtime_error(format(pos, key, what)), pos_(pos), key_(key) {}
+    const SourcePos& pos() const { return pos_; }
+    const std::string& key() const { return key_; }
+
+private:
+    static std::string format(const SourcePos& p, const std::string& key, const std::string& what) {
+        std::string s = p.file;
+        if (p.line > 0) s += ":" + std::to_string(p.line);
+        s += ": ";
+        if (!key.empty()) s += key + ": ";
+        return s + what;
+    }
+    SourcePos pos_;
+    std::string key_;
+};
+
+struct DomainDef {
+    Vec3d lo{0, 0, 0};                      ///< lower corner [m]
+    Vec3d hi{1, 1, 1};                      ///< upper corner [m]
+    std::array<bool, 3> periodic{false, false, false};  ///< periodic per axis
+    Vec3d gravity{0, 0, 0};                 ///< [m/s^2]
+};
+
+struct MaterialDef {
+    std::string name;
+    double density = 2500;        ///< [kg/m^3] (2D: [kg/m^2], areal)
+    double young = 1e7;           ///< Young's modulus [Pa] (2D: stiffness per length [N/m]); Hertz only
+    double poisson = 0.3;         ///< Poisson ratio [-]; Hertz only
+    double restitution = 0.9;     ///< normal coefficient of restitution e [-], 0 < e <= 1
+    double friction = 0.5;        ///< Coulomb friction coefficient mu [-]
+    double tangentialRestitution = 1.0;  ///< beta0 of Walton's rule (event-driven engine) [-], -1..1
+    std::optional<double> dissipationTime;  ///< viscoelastic Hertz A* [s]; default: from e at impact_velocity
+    SourcePos pos;
+};
+
+struct ContactDef {
+    NormalLaw normal = NormalLaw::Linear;
+    /// Linear law from (e, t_c): contact duration [s]. Either duration, or kn (+ gamma_n), must be set.
+    std::optional<double> duration;
+    std::optional<double> kn;      ///< linear normal stiffness [N/m], overrides duration
+    std::optional<double> gammaN;  ///< normal damping, LAMMPS convention F = -m_eff gamma_n v_n [1/s]
+    HertzDamping hertzDamping = HertzDamping::Viscoelastic;
+    TangentialLaw tangential = TangentialLaw::Spring;
+    std::optional<double> kt;      ///< tangential stiffness [N/m]; default kt_ratio * kn
+    std::optional<double> ktRatio;  ///< kt/kn [-]; default q/(1+q): 2/7 spheres, 1/3 disks
+    double gammaT = 0;             ///< tangential damping, LAMMPS convention [1/s]
+    bool attraction = false;       ///< false: normal force clipped at zero (no attraction while separating)
+    double impactVelocity = 1.0;   ///< Hertz: impact speed used for t_c and the time-step rule [m/s]
+    SourcePos pos;
+};
+
+struct TdmDef {
+    IntegratorKind integrator = IntegratorKind::Verlet;
+    std::optional<double> dt;      ///< time step [s]; unset = "auto": t_c / steps_per_contact
+    double stepsPerContact = 50;   ///< auto rule: dt = t_c / steps_per_contact [-]
+    std::optional<double> skin;    ///< Verlet-list skin [m]; default 0.1 x smallest diameter... see docs
+    double maxOverlap = 0.5;       ///< blow-up: stop when overlap / smaller radius exceeds this [-]
+    int sortEvery = 1000;          ///< spatial re-sort of particles every N steps (0 = never)
+    SourcePos pos;
+};
+
+struct WallDef {
+    Vec3d point{0, 0, 0};    ///< a point on the plane [m]
+    Vec3d normal{0, 0, 1};   ///< unit normal pointing into the domain (normalised by the loader)
+    Vec3d velocity{0, 0, 0}; ///< translation velocity of the plane [m/s]
+    int material = 0;        ///< index into Scenario::materials
+    SourcePos pos;
+};
+
+struct InsertDef {
+    Arrangement arrangement = Arrangement::Random;
+    std::size_t count = 0;             ///< number of particles (lattice: at most this many)
+    double radiusMin = 0, radiusMax = 0;  ///< radius range [m], uniform; equal for monodisperse
+    int material = 0;
+    Vec3d regionLo{0, 0, 0}, regionHi{0, 0, 0};  ///< box the centres+radii must fit in [m]
+    std::optional<double> spacing;     ///< lattice spacing [m]; default 2 * radius_max
+    Vec3d velocity{0, 0, 0};           ///< mean velocity [m/s]
+    double temperature = 0;            ///< velocity variance per component [m^2/s^2] (Maxwellian)
+    bool frozen = false;
+    std::string file;                  ///< arrangement = File: path (resolved against the scenario dir)
+    FileFormat format = FileFormat::Csv;
+    SourcePos pos;
+};
+
+struct OutputDef {
+    std::string directory = "out";    ///< run directory (--out overrides)
+    double seriesPeriod = 0;          ///< [s] between rows of series.csv; 0 = 1/100 of duration
+    double snapshotPeriod = 0;        ///< [s] between snapshots; 0 = 1/20 of duration; < 0 = none
+    SourcePos pos;
+};
+
+struct Scenario {
+    std::string path;        ///< scenario file
+    std::string name;
+    int dimension = 3;
+    Method method = Method::Tdm;
+    double duration = 0;     ///< simulated time [s]
+    std::uint64_t seed = 1;
+    DomainDef domain;
+    std::vector<MaterialDef> materials;
+    ContactDef contact;
+    TdmDef tdm;
+    std::vector<WallDef> walls;
+    std::vector<InsertDef> inserts;
+    OutputDef output;
+    std::string hash;        ///< hash of the file contents (hex)
+};
+
+}  // namespace haet

@@ -1,0 +1,171 @@
+#include "tdm/engine.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace haet {
+
+template <int D>
+TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s) {
+    if (s.integrator == IntegratorKind::Gear5)
+        integ_ = std::make_unique<Gear5<D>>();
+    else
+        integ_ = std::make_unique<VelocityVerlet<D>>();
+    wallHistory_.assign(w_.particles.size() * w_.walls.size(), Vec<D>::zero());
+    rebuildIfNeeded(true);
+    motion_.v = w_.particles.v;
+    motion_.w = w_.particles.w;
+    computeForces();
+    integ_->start(w_.particles, s_.dt);
+}
+
+template <int D>
+TdmEngine<D>::~TdmEngine() = default;
+
+template <int D>
+void TdmEngine<D>::computeForces() {
+    const ContactSetup& cs = w_.contact;
+    auto run = [&](auto normal, auto tangential) {
+        using N = decltype(normal);
+        using T = decltype(tangential);
+        stats_ = haet::computeForces<D, N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain, w_.time,
+                                              s_.dt, motion_.v.data(), motion_.w.data(), scratch_);
+    };
+    auto withTangential = [&](auto normal) {
+        if (cs.tangential == TangentialLaw::Spring)
+            run(normal, SpringTangential{});
+        else
+            run(normal, NoTangential{});
+    };
+    if (cs.normal == NormalLaw::Linear)
+        withTangential(LinearNormal{});
+    else if (cs.hertzDamping == HertzDamping::Tsuji)
+        withTangential(HertzTsujiNormal{});
+    else
+        withTangential(HertzViscoNormal{});  // A* = 0 is the undamped Hertz law
+}
+
+template <int D>
+void TdmEngine<D>::rebuildIfNeeded(bool force) {
+    Particles<D>& p = w_.particles;
+    const std::size_t n = p.size();
+    if (!force) {
+        const double lim2 = 0.25 * s_.skin * s_.skin;
+        bool moved = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved) if (n >= kParallelMin)
+        for (std::size_t i = 0; i < n; ++i)
+            if (norm2(p.x[i] - xAtBuild_[i]) > lim2) moved = true;
+        if (!moved) return;
+    }
+    wrapPositions(p, w_.domain);
+    if (s_.sortEvery > 0 && (force || steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery))) {
+        double rmax = 0;
+        for (double r : p.radius) rmax = std::max(rmax, r);
+        const auto order = spatialOrder(p, w_.domain, 2 * rmax + s_.skin);
+        p.permute(order);
+        permutePairList(pairs_, order);
+        if (integ_ && steps_ > 0) integ_->permute(order);
+        if (!motion_.v.empty()) {
+            auto mv = motion_.v;
+            auto mw = motion_.w;
+            for (std::size_t k = 0; k < n; ++k) {
+                motion_.v[k] = mv[order[k]];
+                motion_.w[k] = mw[order[k]];
+            }
+        }
+        const std::size_t nw = w_.walls.size();
+        if (nw > 0) {
+            std::vector<Vec<D>> wh(wallHistory_.size());
+            for (std::size_t k = 0; k < n; ++k)
+                for (std::size_t q = 0; q < nw; ++q) wh[k * nw + q] = wallHistory_[order[k] * nw + q];
+            wallHistory_.swap(wh);
+        }
+        lastSort_ = steps_;
+    }
+    PairList<D> fresh;
+    buildPairList(p, w_.domain, NeighborSettings{s_.skin, true}, pairs_, fresh);
+    pairs_ = std::move(fresh);
+    xAtBuild_ = p.x;
+    ++rebuilds_;
+}
+
+template <int D>
+void TdmEngine<D>::step() {
+    Particles<D>& p = w_.particles;
+    integ_->predict(p, s_.dt, motion_);
+    w_.time += s_.dt;
+    ++steps_;
+    rebuildIfNeeded(false);
+    computeForces();
+    integ_->correct(p, s_.dt);
+    checkHealth();
+}
+
+template <int D>
+void TdmEngine<D>::advanceTo(double t) {
+    while (w_.time + 0.5 * s_.dt <= t) step();
+}
+
+template <int D>
+void TdmEngine<D>::checkHealth() const {
+    const Particles<D>& p = w_.particles;
+    auto fail = [&](std::size_t i, const std::string& what) {
+        std::ostringstream os;
+        os << what << " at particle id " << p.id[i] << " (t = " << w_.time << " s, step " << steps_
+           << "): the time step is probably too large for the contact stiffness (dt = " << s_.dt
+           << " s; contact duration " << w_.contact.contactTime << " s)";
+        throw SimulationError(os.str());
+    };
+    if (stats_.maxOverlapRatio > s_.maxOverlap) {
+        std::ostringstream os;
+        os << "overlap " << stats_.maxOverlapRatio << " x radius exceeds max_overlap = " << s_.maxOverlap;
+        fail(stats_.worstParticle, os.str());
+    }
+    // A NaN anywhere reaches the force of its particle in the same step.
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const Vec<D>& f = p.f[i];
+        double s = 0;
+        for (int k = 0; k < D; ++k) s += f[k] + p.x[i][k];
+        if (!std::isfinite(s)) fail(i, "non-finite position or force");
+    }
+}
+
+template <int D>
+double TdmEngine<D>::contactEnergy() const {
+    const Particles<D>& p = w_.particles;
+    const ContactSetup& cs = w_.contact;
+    auto elastic = [&](const PairCoeffs& c, double delta, double meff, double reff) {
+        if (cs.normal == NormalLaw::Linear) return 0.5 * (c.knConst + c.knPerMeff * meff) * delta * delta;
+        return 0.4 * c.hertzK * std::sqrt(reff) * std::pow(delta, 2.5);
+    };
+    double e = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        for (std::uint32_t k = pairs_.first[i]; k < pairs_.first[i + 1]; ++k) {
+            const std::uint32_t j = pairs_.partner[k];
+            const Vec<D> d = p.x[i] - p.x[j] + pairs_.shiftVec[pairs_.shift[k]];
+            const double rs = p.radius[i] + p.radius[j];
+            const double delta = rs - norm(d);
+            if (delta <= 0) continue;
+            const bool fi = p.frozen(i), fj = p.frozen(j);
+            const double meff = fi ? p.mass[j] : (fj ? p.mass[i] : p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]));
+            e += elastic(cs.pair(p.material[i], p.material[j]), delta, meff, p.radius[i] * p.radius[j] / rs);
+        }
+        for (const Wall<D>& wall : w_.walls) {
+            const double delta = p.radius[i] - wall.distance(p.x[i], w_.time);
+            if (delta > 0) e += elastic(cs.pair(p.material[i], wall.material), delta, p.mass[i], p.radius[i]);
+        }
+    }
+    return e;
+}
+
+template <int D>
+double TdmEngine<D>::pairVirial() const {
+    double s = 0;
+    for (double v : scratch_.virial) s += v;
+    return s;
+}
+
+template class TdmEngine<2>;
+template class TdmEngine<3>;
+
+}  // namespace haet

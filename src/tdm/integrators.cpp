@@ -1,0 +1,186 @@
+#include "tdm/integrators.hpp"
+
+namespace haet {
+
+template <class T>
+static void permuteVec(std::vector<T>& a, const std::vector<std::uint32_t>& order) {
+    if (a.empty()) return;
+    std::vector<T> tmp(a.size());
+    for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
+    a.swap(tmp);
+}
+
+// ---- velocity Verlet ----
+
+template <int D>
+void VelocityVerlet<D>::start(const Particles<D>& p, double) {
+    const std::size_t n = p.size();
+    acc_.resize(n);
+    alpha_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        acc_[i] = p.f[i] * p.invMass[i];
+        alpha_[i] = p.torque[i] * p.invInertia[i];
+    }
+}
+
+template <int D>
+void VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
+    const std::size_t n = p.size();
+    const double h2 = 0.5 * dt * dt;
+    m.v.resize(n);
+    m.w.resize(n);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (std::size_t i = 0; i < n; ++i) {
+        if (p.flags[i] & kFrozen) {
+            m.v[i] = p.v[i];
+            m.w[i] = p.w[i];
+            continue;
+        }
+        m.v[i] = p.v[i] + acc_[i] * (0.5 * dt);  // v(t + dt/2)
+        m.w[i] = p.w[i] + alpha_[i] * (0.5 * dt);
+        p.x[i] += p.v[i] * dt + acc_[i] * h2;
+        p.v[i] += acc_[i] * dt;
+        p.angle[i] += p.w[i] * dt + alpha_[i] * h2;
+        p.w[i] += alpha_[i] * dt;
+    }
+}
+
+template <int D>
+void VelocityVerlet<D>::correct(Particles<D>& p, double dt) {
+    const std::size_t n = p.size();
+    const double h = 0.5 * dt;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (std::size_t i = 0; i < n; ++i) {
+        if (p.flags[i] & kFrozen) continue;
+        const Vec<D> a = p.f[i] * p.invMass[i];
+        const Ang<D> al = p.torque[i] * p.invInertia[i];
+        p.v[i] += (a - acc_[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
+        p.w[i] += (al - alpha_[i]) * h;
+        acc_[i] = a;
+        alpha_[i] = al;
+    }
+}
+
+template <int D>
+void VelocityVerlet<D>::permute(const std::vector<std::uint32_t>& order) {
+    permuteVec(acc_, order);
+    permuteVec(alpha_, order);
+}
+
+template <int D>
+void VelocityVerlet<D>::restart(const Particles<D>& p, std::size_t i, double) {
+    if (acc_.size() < p.size()) {
+        acc_.resize(p.size());
+        alpha_.resize(p.size());
+    }
+    acc_[i] = p.f[i] * p.invMass[i];
+    alpha_[i] = p.torque[i] * p.invInertia[i];
+}
+
+// ---- Gear ----
+
+template <int D>
+void Gear5<D>::start(const Particles<D>& p, double dt) {
+    const std::size_t n = p.size();
+    for (auto& a : y_) a.assign(n, Vec<D>::zero());
+    for (auto& a : r_) a.assign(n, Ang<D>::zero());
+    for (std::size_t i = 0; i < n; ++i) restart(p, i, dt);
+}
+
+template <int D>
+void Gear5<D>::restart(const Particles<D>& p, std::size_t i, double dt) {
+    if (y_[0].size() < p.size()) {
+        for (auto& a : y_) a.resize(p.size(), Vec<D>::zero());
+        for (auto& a : r_) a.resize(p.size(), Ang<D>::zero());
+    }
+    // Higher derivatives from the current force with zero jerk: exact for free flight under gravity, and the
+    // best local guess for a particle not yet in contact (PHYSICS.md F.1).
+    const double h2 = 0.5 * dt * dt;
+    y_[0][i] = p.f[i] * (p.invMass[i] * h2);
+    r_[0][i] = p.torque[i] * (p.invInertia[i] * h2);
+    for (int k = 1; k < 4; ++k) {
+        y_[k][i] = Vec<D>::zero();
+        r_[k][i] = Ang<D>::zero();
+    }
+}
+
+template <int D>
+void Gear5<D>::setDerivatives(std::size_t i, const Vec<D>& a, const Vec<D>& j3, const Vec<D>& j4, const Vec<D>& j5,
+                              double dt) {
+    const double h2 = dt * dt / 2, h3 = h2 * dt / 3, h4 = h3 * dt / 4, h5 = h4 * dt / 5;
+    y_[0][i] = a * h2;
+    y_[1][i] = j3 * h3;
+    y_[2][i] = j4 * h4;
+    y_[3][i] = j5 * h5;
+}
+
+namespace {
+/// Pascal-triangle predictor on (x, y1 = v dt, y2..y5).
+template <int N>
+inline void gearPredict(Vec<N>& x, Vec<N>& v, Vec<N>& y2, Vec<N>& y3, Vec<N>& y4, Vec<N>& y5, double dt,
+                        Vec<N>& stepVel) {
+    Vec<N> y1 = v * dt;
+    const Vec<N> dx = y1 + y2 + y3 + y4 + y5;
+    stepVel = dx * (1.0 / dt);
+    x += dx;
+    y1 += y2 * 2.0 + y3 * 3.0 + y4 * 4.0 + y5 * 5.0;
+    y2 += y3 * 3.0 + y4 * 6.0 + y5 * 10.0;
+    y3 += y4 * 4.0 + y5 * 10.0;
+    y4 += y5 * 5.0;
+    v = y1 * (1.0 / dt);
+}
+
+template <int N>
+inline void gearCorrect(Vec<N>& x, Vec<N>& v, Vec<N>& y2, Vec<N>& y3, Vec<N>& y4, Vec<N>& y5, const Vec<N>& acc,
+                        double dt) {
+    const Vec<N> delta = acc * (0.5 * dt * dt) - y2;
+    const double* c = Gear5<3>::kC;
+    x += delta * c[0];
+    v += delta * (c[1] / dt);
+    y2 += delta * c[2];
+    y3 += delta * c[3];
+    y4 += delta * c[4];
+    y5 += delta * c[5];
+}
+}  // namespace
+
+template <int D>
+void Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
+    const std::size_t n = p.size();
+    m.v.resize(n);
+    m.w.resize(n);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (std::size_t i = 0; i < n; ++i) {
+        if (p.flags[i] & kFrozen) {
+            m.v[i] = p.v[i];
+            m.w[i] = p.w[i];
+            continue;
+        }
+        gearPredict(p.x[i], p.v[i], y_[0][i], y_[1][i], y_[2][i], y_[3][i], dt, m.v[i]);
+        gearPredict(p.angle[i], p.w[i], r_[0][i], r_[1][i], r_[2][i], r_[3][i], dt, m.w[i]);
+    }
+}
+
+template <int D>
+void Gear5<D>::correct(Particles<D>& p, double dt) {
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (std::size_t i = 0; i < n; ++i) {
+        if (p.flags[i] & kFrozen) continue;
+        gearCorrect(p.x[i], p.v[i], y_[0][i], y_[1][i], y_[2][i], y_[3][i], p.f[i] * p.invMass[i], dt);
+        gearCorrect(p.angle[i], p.w[i], r_[0][i], r_[1][i], r_[2][i], r_[3][i], p.torque[i] * p.invInertia[i], dt);
+    }
+}
+
+template <int D>
+void Gear5<D>::permute(const std::vector<std::uint32_t>& order) {
+    for (auto& a : y_) permuteVec(a, order);
+    for (auto& a : r_) permuteVec(a, order);
+}
+
+template class VelocityVerlet<2>;
+template class VelocityVerlet<3>;
+template class Gear5<2>;
+template class Gear5<3>;
+
+}  // namespace haet
