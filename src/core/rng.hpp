@@ -22,8 +22,8 @@ inline std::array<std::uint32_t, 4> philox4x32(std::array<std::uint32_t, 4> ctr,
     for (int round = 0; round < 10; ++round) {
         const std::uint64_t p0 = std::uint64_t(kM0) * ctr[0];
         const std::uint64_t p1 = std::uint64_t(kM1) * ctr[2];
-        ctr = {std::uint32_t(p1 >> 32) ^ ctr[1] ^ key[0], std::uint32_t(p1),
-               std::uint32_t(p0 >> 32) ^ ctr[3] ^ key[1], std::uint32_t(p0)};
+        ctr = {std::uint32_t(p1 >> 32) ^ ctr[1] ^ key[0], std::uint32_t(p1), std::uint32_t(p0 >> 32) ^ ctr[3] ^ key[1],
+               std::uint32_t(p0)};
         key[0] += kW0;
         key[1] += kW1;
     }

@@ -1,0 +1,62 @@
+#include "io/atomic_file.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <system_error>
+
+#include <unistd.h>
+
+namespace haet {
+
+namespace {
+
+std::filesystem::path tempPathFor(const std::filesystem::path& target) {
+    std::filesystem::path temp = target;
+    temp += ".tmp." + std::to_string(::getpid());
+    return temp;
+}
+
+// errno is set by the failed open/write underneath std::ofstream (libstdc++ uses POSIX calls).
+std::string lastSystemError() { return errno != 0 ? std::string(std::strerror(errno)) : "unknown error"; }
+
+}  // namespace
+
+AtomicOfstream::AtomicOfstream(std::filesystem::path target)
+    : target_(std::move(target)), temp_(tempPathFor(target_)) {
+    errno = 0;
+    out_.open(temp_, std::ios::binary | std::ios::trunc);
+    if (!out_) throw IoError(target_, "cannot create temporary file " + temp_.string() + ": " + lastSystemError());
+}
+
+AtomicOfstream::~AtomicOfstream() {
+    if (committed_) return;
+    out_.close();
+    std::error_code ignored;  // a destructor must not throw; a stale temp file is harmless
+    std::filesystem::remove(temp_, ignored);
+}
+
+AtomicOfstream& AtomicOfstream::write(const void* data, std::size_t bytes) {
+    out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
+    return *this;
+}
+
+void AtomicOfstream::commit() {
+    if (committed_) throw IoError(target_, "AtomicOfstream committed twice");
+    errno = 0;
+    out_.flush();
+    const bool written = static_cast<bool>(out_);
+    out_.close();
+    if (!written || out_.fail()) throw IoError(target_, "write to " + temp_.string() + " failed: " + lastSystemError());
+    std::error_code ec;
+    std::filesystem::rename(temp_, target_, ec);
+    if (ec) throw IoError(target_, "cannot rename " + temp_.string() + " over it: " + ec.message());
+    committed_ = true;
+}
+
+void writeFileAtomic(const std::filesystem::path& path, std::string_view content) {
+    AtomicOfstream out(path);
+    out.write(content.data(), content.size());
+    out.commit();
+}
+
+}  // namespace haet

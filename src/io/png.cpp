@@ -1,0 +1,341 @@
+#include "io/png.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include <cairo.h>
+#include <fmt/format.h>
+
+#include "io/atomic_file.hpp"
+
+namespace haet {
+
+namespace {
+
+constexpr int kMaxPx = 16384;  // well inside Cairo's 32767 limit, and a 1 GiB ARGB buffer at most
+constexpr double kPi = 3.14159265358979323846;
+constexpr std::uint32_t kInk = 0x262626;  // outlines, axes and text
+constexpr std::size_t kMaxMarkers = 60;   // denser series would be hidden under their own dots
+
+struct Canvas {
+    std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface{nullptr, cairo_surface_destroy};
+    std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr{nullptr, cairo_destroy};
+};
+
+Canvas makeCanvas(const std::filesystem::path& path, int width, int height) {
+    if (width < 1 || height < 1 || width > kMaxPx || height > kMaxPx)
+        throw std::invalid_argument(
+            fmt::format("{}: image size {}x{} px is outside 1..{}", path.string(), width, height, kMaxPx));
+    Canvas c;
+    c.surface.reset(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height));
+    c.cr.reset(cairo_create(c.surface.get()));
+    if (cairo_status(c.cr.get()) != CAIRO_STATUS_SUCCESS)
+        throw IoError(path, std::string("cannot create image: ") + cairo_status_to_string(cairo_status(c.cr.get())));
+    cairo_set_source_rgb(c.cr.get(), 1, 1, 1);
+    cairo_paint(c.cr.get());
+    return c;
+}
+
+void setColor(cairo_t* cr, std::uint32_t rgb, double alpha = 1.0) {
+    cairo_set_source_rgba(cr, ((rgb >> 16) & 0xff) / 255.0, ((rgb >> 8) & 0xff) / 255.0, (rgb & 0xff) / 255.0, alpha);
+}
+
+// Cairo's write callback. It must not throw through C code: errors stay in the stream and commit() reports them.
+cairo_status_t writeChunk(void* closure, const unsigned char* data, unsigned int length) {
+    auto* out = static_cast<AtomicOfstream*>(closure);
+    out->write(data, length);
+    return out->stream() ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
+}
+
+void savePng(cairo_surface_t* surface, const std::filesystem::path& path) {
+    cairo_surface_flush(surface);
+    AtomicOfstream out(path);
+    const cairo_status_t status = cairo_surface_write_to_png_stream(surface, writeChunk, &out);
+    if (status != CAIRO_STATUS_SUCCESS)
+        throw IoError(path, std::string("PNG encoding failed: ") + cairo_status_to_string(status));
+    out.commit();
+}
+
+/// Draws `s` so that the point (x, y) [px] sits at fraction (ax, ay) of its box: (0, 0) top left,
+/// (0.5, 0.5) centre, (1, 1) bottom right.
+void drawText(cairo_t* cr, const std::string& s, double x, double y, double ax, double ay) {
+    cairo_text_extents_t e;
+    cairo_text_extents(cr, s.c_str(), &e);
+    cairo_move_to(cr, x - e.x_bearing - ax * e.width, y - e.y_bearing - ay * e.height);
+    cairo_show_text(cr, s.c_str());
+}
+
+}  // namespace
+
+void writePng(const std::filesystem::path& path, const PngScene& scene) {
+    const double spanX = scene.hi[0] - scene.lo[0];
+    const double spanY = scene.hi[1] - scene.lo[1];
+    if (!(spanX > 0 && spanY > 0)) throw std::invalid_argument(path.string() + ": empty view (hi <= lo)");
+    const double scale = scene.widthPx / spanX;  // [px/m]
+    const double heightPx = std::round(spanY * scale);
+    Canvas canvas = makeCanvas(path, scene.widthPx, static_cast<int>(std::clamp(heightPx, 1.0, kMaxPx + 1.0)));
+    cairo_t* cr = canvas.cr.get();
+    auto px = [&](double x) { return (x - scene.lo[0]) * scale; };
+    auto py = [&](double y) { return (scene.hi[1] - y) * scale; };
+    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+
+    for (const PngScene::Polygon& p : scene.polygons) {
+        if (p.pts.size() < 3) continue;
+        cairo_move_to(cr, px(p.pts[0][0]), py(p.pts[0][1]));
+        for (std::size_t k = 1; k < p.pts.size(); ++k) cairo_line_to(cr, px(p.pts[k][0]), py(p.pts[k][1]));
+        cairo_close_path(cr);
+        setColor(cr, p.rgb);
+        cairo_fill_preserve(cr);
+        setColor(cr, kInk);
+        cairo_set_line_width(cr, 0.75);
+        cairo_stroke(cr);
+    }
+    for (const PngScene::Disk& d : scene.disks) {
+        const double rPx = d.r * scale;
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, px(d.x), py(d.y), rPx, 0, 2 * kPi);
+        setColor(cr, d.rgb);
+        // Below ~2 px an outline would hide the fill colour entirely.
+        if (rPx < 2) {
+            cairo_fill(cr);
+            continue;
+        }
+        cairo_fill_preserve(cr);
+        setColor(cr, kInk);
+        cairo_set_line_width(cr, std::min(0.75, 0.25 * rPx));
+        cairo_stroke(cr);
+    }
+    setColor(cr, kInk);
+    cairo_set_line_width(cr, 2.0);
+    cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+    for (const PngScene::Segment& s : scene.walls) {
+        cairo_move_to(cr, px(s.x0), py(s.y0));
+        cairo_line_to(cr, px(s.x1), py(s.y1));
+        cairo_stroke(cr);
+    }
+
+    if (!scene.caption.empty()) {
+        cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+        cairo_set_font_size(cr, std::clamp(scene.widthPx / 50.0, 10.0, 24.0));
+        cairo_text_extents_t e;
+        cairo_text_extents(cr, scene.caption.c_str(), &e);
+        const double pad = 4;
+        cairo_rectangle(cr, pad, pad, e.width + 2 * pad, e.height + 2 * pad);
+        cairo_set_source_rgba(cr, 1, 1, 1, 0.8);  // keeps the caption legible over particles
+        cairo_fill(cr);
+        setColor(cr, kInk);
+        drawText(cr, scene.caption, 2 * pad, 2 * pad, 0, 0);
+    }
+    savePng(canvas.surface.get(), path);
+}
+
+namespace {
+
+struct Axis {
+    double lo = 0, hi = 1;
+    bool log = false;
+    std::vector<double> ticks;
+
+    double fraction(double v) const {
+        return log ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo)) : (v - lo) / (hi - lo);
+    }
+};
+
+bool usable(double v, bool log) { return std::isfinite(v) && (!log || v > 0); }
+
+/// 1, 2 or 5 times a power of ten, near range/6: about six labelled ticks.
+double niceStep(double range) {
+    const double raw = range / 6;
+    const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+    const double m = raw / mag;
+    return (m < 1.5 ? 1 : m < 3.5 ? 2 : m < 7.5 ? 5 : 10) * mag;
+}
+
+/// Axis limits rounded out to ticks, from the finite data range [lo, hi] (lo > hi when there is no data).
+Axis makeAxis(double lo, double hi, bool log) {
+    Axis a;
+    a.log = log;
+    if (log) {
+        if (lo > hi) lo = 1, hi = 10;
+        double e0 = std::floor(std::log10(lo)), e1 = std::ceil(std::log10(hi));
+        if (e1 <= e0) e1 = e0 + 1;
+        const double stride = std::ceil((e1 - e0) / 8);
+        e1 = e0 + stride * std::ceil((e1 - e0) / stride);
+        a.lo = std::pow(10.0, e0);
+        a.hi = std::pow(10.0, e1);
+        for (double e = e0; e <= e1 + 0.5; e += stride) a.ticks.push_back(std::pow(10.0, e));
+        return a;
+    }
+    if (lo > hi) lo = 0, hi = 1;
+    if (lo == hi) {
+        const double d = lo == 0 ? 1 : 0.1 * std::abs(lo);
+        lo -= d, hi += d;
+    }
+    const double step = niceStep(hi - lo);
+    const double k0 = std::floor(lo / step), k1 = std::ceil(hi / step);
+    a.lo = k0 * step;
+    a.hi = k1 * step;
+    for (double k = k0; k <= k1 + 0.5; k += 1) a.ticks.push_back(std::abs(k) < 0.5 ? 0.0 : k * step);
+    return a;
+}
+
+}  // namespace
+
+void writeLinePlotPng(const std::filesystem::path& path, const std::string& title, const std::string& xlabel,
+                      const std::string& ylabel, const std::vector<PlotSeries>& series,
+                      const LinePlotOptions& options) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    double xLo = inf, xHi = -inf, yLo = inf, yHi = -inf;
+    for (const PlotSeries& s : series)
+        for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i)
+            if (usable(s.x[i], options.logX) && usable(s.y[i], options.logY)) {
+                xLo = std::min(xLo, s.x[i]), xHi = std::max(xHi, s.x[i]);
+                yLo = std::min(yLo, s.y[i]), yHi = std::max(yHi, s.y[i]);
+            }
+    const Axis ax = makeAxis(xLo, xHi, options.logX);
+    const Axis ay = makeAxis(yLo, yHi, options.logY);
+
+    Canvas canvas = makeCanvas(path, options.widthPx, options.heightPx);
+    cairo_t* cr = canvas.cr.get();
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    // Plot rectangle [px]: room on the left for y tick labels and the y label, at the bottom for x.
+    const double left = 80, right = options.widthPx - 40.0, top = 44, bottom = options.heightPx - 56.0;
+    if (right - left < 20 || bottom - top < 20)
+        throw std::invalid_argument(path.string() + ": plot image too small for axes");
+    auto px = [&](double x) { return left + ax.fraction(x) * (right - left); };
+    auto py = [&](double y) { return bottom - ay.fraction(y) * (bottom - top); };
+
+    cairo_set_font_size(cr, 12);
+    cairo_set_line_width(cr, 1);
+    for (double t : ax.ticks) {
+        const double x = std::round(px(t)) + 0.5;  // half-pixel: crisp 1 px lines
+        setColor(cr, 0xdddddd);
+        cairo_move_to(cr, x, top);
+        cairo_line_to(cr, x, bottom);
+        cairo_stroke(cr);
+        setColor(cr, kInk);
+        cairo_move_to(cr, x, bottom);
+        cairo_line_to(cr, x, bottom + 5);
+        cairo_stroke(cr);
+        drawText(cr, fmt::format("{:g}", t), x, bottom + 8, 0.5, 0);
+    }
+    for (double t : ay.ticks) {
+        const double y = std::round(py(t)) + 0.5;
+        setColor(cr, 0xdddddd);
+        cairo_move_to(cr, left, y);
+        cairo_line_to(cr, right, y);
+        cairo_stroke(cr);
+        setColor(cr, kInk);
+        cairo_move_to(cr, left - 5, y);
+        cairo_line_to(cr, left, y);
+        cairo_stroke(cr);
+        drawText(cr, fmt::format("{:g}", t), left - 8, y, 1, 0.5);
+    }
+    setColor(cr, kInk);
+    cairo_rectangle(cr, left + 0.5, top + 0.5, right - left, bottom - top);
+    cairo_stroke(cr);
+
+    cairo_set_font_size(cr, 14);
+    drawText(cr, xlabel, 0.5 * (left + right), options.heightPx - 8.0, 0.5, 1);
+    cairo_save(cr);
+    cairo_translate(cr, 14, 0.5 * (top + bottom));
+    cairo_rotate(cr, -kPi / 2);
+    drawText(cr, ylabel, 0, 0, 0.5, 0);
+    cairo_restore(cr);
+    cairo_set_font_size(cr, 16);
+    drawText(cr, title, 0.5 * (left + right), 0.5 * top, 0.5, 0.5);
+
+    cairo_save(cr);
+    cairo_rectangle(cr, left, top, right - left, bottom - top);
+    cairo_clip(cr);
+    cairo_set_line_width(cr, 2);
+    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+    for (const PlotSeries& s : series) {
+        const std::size_t n = std::min(s.x.size(), s.y.size());
+        setColor(cr, s.rgb);
+        bool penDown = false;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!usable(s.x[i], ax.log) || !usable(s.y[i], ay.log)) {
+                penDown = false;
+                continue;
+            }
+            if (penDown)
+                cairo_line_to(cr, px(s.x[i]), py(s.y[i]));
+            else
+                cairo_move_to(cr, px(s.x[i]), py(s.y[i]));
+            penDown = true;
+        }
+        cairo_stroke(cr);
+        if (!options.markers || n > kMaxMarkers) continue;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!usable(s.x[i], ax.log) || !usable(s.y[i], ay.log)) continue;
+            cairo_new_sub_path(cr);
+            cairo_arc(cr, px(s.x[i]), py(s.y[i]), 3, 0, 2 * kPi);
+        }
+        cairo_fill(cr);
+    }
+    cairo_restore(cr);
+
+    std::vector<const PlotSeries*> labelled;
+    for (const PlotSeries& s : series)
+        if (!s.label.empty()) labelled.push_back(&s);
+    if (!labelled.empty()) {
+        cairo_set_font_size(cr, 12);
+        double textWidth = 0;
+        for (const PlotSeries* s : labelled) {
+            cairo_text_extents_t e;
+            cairo_text_extents(cr, s->label.c_str(), &e);
+            textWidth = std::max(textWidth, e.x_advance);
+        }
+        const double rowH = 18, w = textWidth + 44, h = rowH * labelled.size() + 8;
+        // The corner (top right, top left, bottom right, bottom left) that hides the least of the lines,
+        // judged by samples along every drawn segment.
+        const double corners[4][2] = {{right - w - 8, top + 8}, {left + 8, top + 8},
+                                      {right - w - 8, bottom - h - 8}, {left + 8, bottom - h - 8}};
+        std::size_t hidden[4] = {0, 0, 0, 0};
+        auto sample = [&](double x, double y) {
+            for (std::size_t c = 0; c < 4; ++c)
+                hidden[c] += x >= corners[c][0] && x <= corners[c][0] + w && y >= corners[c][1] &&
+                             y <= corners[c][1] + h;
+        };
+        for (const PlotSeries& s : series) {
+            bool havePrev = false;
+            double xPrev = 0, yPrev = 0;
+            for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
+                if (!usable(s.x[i], ax.log) || !usable(s.y[i], ay.log)) {
+                    havePrev = false;
+                    continue;
+                }
+                const double x = px(s.x[i]), y = py(s.y[i]);
+                if (havePrev)
+                    for (int k = 1; k < 16; ++k) sample(xPrev + (x - xPrev) * k / 16, yPrev + (y - yPrev) * k / 16);
+                sample(x, y);
+                havePrev = true, xPrev = x, yPrev = y;
+            }
+        }
+        const std::size_t best = static_cast<std::size_t>(std::min_element(hidden, hidden + 4) - hidden);
+        const double x0 = corners[best][0], y0 = corners[best][1];
+        cairo_rectangle(cr, x0, y0, w, h);
+        cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
+        cairo_fill_preserve(cr);
+        setColor(cr, 0xaaaaaa);
+        cairo_set_line_width(cr, 1);
+        cairo_stroke(cr);
+        for (std::size_t k = 0; k < labelled.size(); ++k) {
+            const double y = y0 + 4 + rowH * (k + 0.5);
+            setColor(cr, labelled[k]->rgb);
+            cairo_set_line_width(cr, 2);
+            cairo_move_to(cr, x0 + 8, y);
+            cairo_line_to(cr, x0 + 30, y);
+            cairo_stroke(cr);
+            setColor(cr, kInk);
+            drawText(cr, labelled[k]->label, x0 + 36, y, 0, 0.5);
+        }
+    }
+    savePng(canvas.surface.get(), path);
+}
+
+}  // namespace haet

@@ -1,0 +1,77 @@
+#pragma once
+// VTK XML output for ParaView: particles as an UnstructuredGrid (.vtu), walls as PolyData (.vtp), and a
+// .pvd collection that maps files to simulation times.
+//
+// Arrays use the binary "appended raw" encoding (header_type UInt64, LittleEndian): the XML head gives each
+// array's byte offset, and the raw blocks follow one `_` marker, each prefixed by its byte count as UInt64.
+// Chosen over inline base64 because it is the fastest to write and to read and needs no encoding step;
+// the blocks are streamed straight from the caller's arrays. Every file is written atomically.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace haet {
+
+/// One named array attached to points or cells. Not owning: `data` must stay valid during the write call.
+struct VtkField {
+    enum Type { Float64, Int32, Int64, UInt8 };
+    std::string name;
+    int components = 1;          ///< values per point or cell (3 for a vector)
+    Type type = Float64;
+    const void* data = nullptr;  ///< count*components values of `type`, interleaved (x0 y0 z0 x1 ...)
+};
+
+/// Writes n points as VTK_VERTEX cells. xyz holds 3*n coordinates [m] (2D callers pass z = 0).
+/// `time` [s] is stored as the FieldData array TimeValue. Throws IoError, or std::invalid_argument for a
+/// malformed field.
+void writeVtuPoints(const std::filesystem::path& path, std::size_t n, const double* xyz,
+                    const std::vector<VtkField>& pointData, double time);
+
+/// Writes polygons as VTK_POLYGON cells. xyz holds 3 coordinates [m] per vertex; offsets is CSR with one
+/// entry per polygon plus one: polygon k uses vertices [offsets[k], offsets[k+1]), offsets.front() == 0 and
+/// offsets.back() == vertex count. Each cellData field holds one tuple per polygon.
+void writeVtuPolygons(const std::filesystem::path& path, std::span<const double> xyz,
+                      std::span<const std::uint32_t> offsets, const std::vector<VtkField>& cellData,
+                      double time);
+
+/// One planar wall as a quadrilateral (2D walls are passed as thin quads by the caller).
+struct WallQuad {
+    std::array<std::array<double, 3>, 4> corners{};  ///< [m], in order around the quad
+    int id = 0;                                       ///< written as cell data "wall_id"
+};
+
+/// Writes the walls as PolyData, one polygon per wall.
+void writeVtpWalls(const std::filesystem::path& path, const std::vector<WallQuad>& quads);
+
+/// A ParaView .pvd collection. The file is rewritten atomically on construction and on every add(), so a
+/// run that stops at any point leaves a valid collection of the snapshots written so far. Each rewrite is
+/// O(entries); fine for the thousands of snapshots a run writes.
+class PvdCollection {
+public:
+    /// Starts an empty collection at pvdPath (replacing any previous one). Throws IoError.
+    explicit PvdCollection(std::filesystem::path pvdPath);
+
+    /// Adds a file (path relative to the .pvd's directory) at `time` [s]. Several files with the same time
+    /// and different `part` numbers form one multi-block timestep (particles, walls). Throws IoError.
+    void add(double time, const std::string& relativeFile, int part = 0);
+
+    const std::filesystem::path& path() const { return path_; }
+    std::size_t size() const { return entries_.size(); }
+
+private:
+    struct Entry {
+        double time;
+        std::string file;
+        int part;
+    };
+    void rewrite() const;
+
+    std::filesystem::path path_;
+    std::vector<Entry> entries_;
+};
+
+}  // namespace haet

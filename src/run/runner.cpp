@@ -1,0 +1,322 @@
+#include "run/runner.hpp"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fmt/format.h>
+#include <omp.h>
+#include <ostream>
+
+#include "core/version.hpp"
+#include "io/atomic_file.hpp"
+#include "io/json.hpp"
+#include "io/series.hpp"
+#include "io/vtk.hpp"
+#include "tdm/engine.hpp"
+#include "world/build.hpp"
+
+namespace haet {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::size_t peakRssBytes() {
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    return static_cast<std::size_t>(ru.ru_maxrss) * 1024;
+}
+
+/// Global measurements of a state (energies in J; pressure in Pa, or N/m in 2D).
+template <int D>
+struct Sample {
+    double kinetic = 0, rotational = 0, potential = 0, elastic = 0;
+    double pressure = std::nan("");
+};
+
+template <int D>
+Sample<D> measure(const World<D>& w, const TdmEngine<D>& eng) {
+    const Particles<D>& p = w.particles;
+    Sample<D> s;
+    double mv2 = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const double m = p.mass[i];
+        const double v2 = norm2(p.v[i]);
+        s.kinetic += 0.5 * m * v2;
+        mv2 += m * v2;
+        s.rotational += 0.5 * p.inertia(i) * norm2(p.w[i]);
+        s.potential -= m * dot(w.domain.gravity, p.x[i] + p.image[i]);
+    }
+    s.elastic = eng.contactEnergy();
+    if (w.domain.fullyPeriodic()) s.pressure = (mv2 + eng.pairVirial()) / (D * w.domain.volume());
+    return s;
+}
+
+template <int D>
+class SnapshotWriter {
+public:
+    SnapshotWriter(const std::filesystem::path& dir) : dir_(dir), pvd_(dir / "particles.pvd"), walls_(dir / "walls.pvd") {}
+
+    void write(const World<D>& w, double time) {
+        const Particles<D>& p = w.particles;
+        const std::size_t n = p.size();
+        std::vector<double> xyz(3 * n, 0.0), vel(3 * n, 0.0), spin(3 * n, 0.0), force(3 * n, 0.0), rad(n);
+        std::vector<std::int64_t> ids(n);
+        std::vector<std::int32_t> mat(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            for (int k = 0; k < D; ++k) {
+                xyz[3 * i + k] = p.x[i][k];
+                vel[3 * i + k] = p.v[i][k];
+                force[3 * i + k] = p.f[i][k];
+            }
+            if constexpr (D == 2) spin[3 * i + 2] = p.w[i][0];
+            else for (int k = 0; k < 3; ++k) spin[3 * i + k] = p.w[i][k];
+            rad[i] = p.radius[i];
+            ids[i] = static_cast<std::int64_t>(p.id[i]);
+            mat[i] = p.material[i];
+        }
+        const std::string name = fmt::format("particles_{:06d}.vtu", count_);
+        writeVtuPoints(dir_ / name, n, xyz.data(),
+                       {{"radius", 1, VtkField::Float64, rad.data()},
+                        {"velocity", 3, VtkField::Float64, vel.data()},
+                        {"angular_velocity", 3, VtkField::Float64, spin.data()},
+                        {"force", 3, VtkField::Float64, force.data()},
+                        {"material", 1, VtkField::Int32, mat.data()},
+                        {"id", 1, VtkField::Int64, ids.data()}},
+                       time);
+        pvd_.add(time, name);
+        if (!w.walls.empty()) {
+            const std::string wname = fmt::format("walls_{:06d}.vtp", count_);
+            writeVtpWalls(dir_ / wname, wallQuads(w, time));
+            walls_.add(time, wname);
+        }
+        ++count_;
+    }
+
+private:
+    /// A wall as a square patch covering the box (a thin quad in 2D).
+    static std::vector<WallQuad> wallQuads(const World<D>& w, double time) {
+        std::vector<WallQuad> quads;
+        const Vec<D> L = w.domain.length();
+        double size = 0;
+        for (int k = 0; k < D; ++k) size = std::max(size, L[k]);
+        for (std::size_t q = 0; q < w.walls.size(); ++q) {
+            const Wall<D>& wl = w.walls[q];
+            std::array<double, 3> c{0, 0, 0}, n{0, 0, 0};
+            const Vec<D> pt = wl.pointAt(time);
+            for (int k = 0; k < D; ++k) {
+                c[k] = pt[k];
+                n[k] = wl.normal[k];
+            }
+            // Centre the patch on the box centre projected onto the plane.
+            std::array<double, 3> mid{0, 0, 0};
+            for (int k = 0; k < D; ++k) mid[k] = 0.5 * (w.domain.lo[k] + w.domain.hi[k]);
+            double off = 0;
+            for (int k = 0; k < 3; ++k) off += (mid[k] - c[k]) * n[k];
+            for (int k = 0; k < 3; ++k) c[k] = mid[k] - off * n[k];
+            // Two tangent directions.
+            std::array<double, 3> a = std::abs(n[0]) < 0.9 ? std::array<double, 3>{1, 0, 0}
+                                                            : std::array<double, 3>{0, 1, 0};
+            if (D == 2) a = {-n[1], n[0], 0};
+            double an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+            for (int k = 0; k < 3; ++k) a[k] -= an * n[k];
+            double al = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            for (int k = 0; k < 3; ++k) a[k] /= al;
+            std::array<double, 3> b{n[1] * a[2] - n[2] * a[1], n[2] * a[0] - n[0] * a[2], n[0] * a[1] - n[1] * a[0]};
+            const double ha = 0.5 * size, hb = D == 2 ? 0.01 * size : 0.5 * size;
+            WallQuad wq;
+            wq.id = static_cast<int>(q);
+            const double sa[4] = {-1, 1, 1, -1}, sb[4] = {-1, -1, 1, 1};
+            for (int v = 0; v < 4; ++v)
+                for (int k = 0; k < 3; ++k) wq.corners[v][k] = c[k] + sa[v] * ha * a[k] + sb[v] * hb * b[k];
+            quads.push_back(wq);
+        }
+        return quads;
+    }
+
+    std::filesystem::path dir_;
+    PvdCollection pvd_, walls_;
+    int count_ = 0;
+};
+
+/// One-line progress on a terminal: simulated time, steps/s, contacts, ETA.
+class Progress {
+public:
+    Progress(bool enabled, double duration) : on_(enabled), duration_(duration), start_(Clock::now()) {}
+    void update(double t, std::uint64_t steps, std::size_t contacts, bool force = false) {
+        if (!on_) return;
+        const auto now = Clock::now();
+        if (!force && now - last_ < std::chrono::milliseconds(200)) return;
+        last_ = now;
+        const double el = std::chrono::duration<double>(now - start_).count();
+        const double frac = std::clamp(t / duration_, 0.0, 1.0);
+        const int width = 30, filled = static_cast<int>(frac * width);
+        const double eta = frac > 0 ? el * (1 - frac) / frac : 0;
+        std::fprintf(stderr, "\r[%s%s] t = %.4g s  %.3g steps/s  %zu contacts  ETA %.0f s   ",
+                     std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), t,
+                     el > 0 ? steps / el : 0.0, contacts, eta);
+        std::fflush(stderr);
+    }
+    void finish() {
+        if (on_) std::fprintf(stderr, "\n");
+    }
+
+private:
+    bool on_;
+    double duration_;
+    Clock::time_point start_, last_{};
+};
+
+template <int D>
+RunStatus runTdm(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
+    const auto t0 = Clock::now();
+    std::filesystem::path dir = opt.outDir.empty() ? std::filesystem::path(sc.output.directory) : opt.outDir;
+    std::filesystem::create_directories(dir);
+
+    World<D> world = buildWorld<D>(sc);
+    std::string dtNote;
+    const TdmSettings ts = tdmSettings<D>(sc, world, &dtNote);
+    TdmEngine<D> eng(world, ts);
+
+    const double seriesPeriod = sc.output.seriesPeriod > 0 ? sc.output.seriesPeriod : sc.duration / 100;
+    const double snapPeriod = sc.output.snapshotPeriod == 0 ? sc.duration / 20 : sc.output.snapshotPeriod;
+    SeriesWriter series(dir / "series.csv",
+                        {"time", "step", "kinetic_energy", "rotational_energy", "potential_energy",
+                         "elastic_energy", "total_energy", "n_particles", "n_contacts", "max_overlap_ratio",
+                         "pressure", "rebuilds"});
+    SnapshotWriter<D> snaps(dir);
+    auto writeRow = [&]() {
+        const Sample<D> s = measure(world, eng);
+        std::optional<double> pr;
+        if (!std::isnan(s.pressure)) pr = s.pressure;
+        series.row({world.time, double(eng.steps()), s.kinetic, s.rotational, s.potential, s.elastic,
+                    s.kinetic + s.rotational + s.potential + s.elastic, double(world.particles.size()),
+                    double(eng.forceStats().contacts), eng.forceStats().maxOverlapRatio, pr,
+                    double(eng.rebuilds())});
+    };
+
+    auto writeRunJson = [&](const std::string& status) {
+        const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+        JsonObject j;
+        j.add("version", kVersion);
+        j.add("scenario", sc.path);
+        j.add("scenario_name", sc.name);
+        j.add("scenario_hash", sc.hash);
+        j.add("method", "tdm");
+        j.add("dimension", static_cast<std::int64_t>(D));
+        j.add("status", status);
+        j.add("n_particles", world.particles.size());
+        j.add("dt", ts.dt);
+        j.add("dt_rule", dtNote);
+        j.add("contact_time", world.contact.contactTime);
+        j.add("simulated_time", world.time);
+        j.add("steps", eng.steps());
+        j.add("neighbor_rebuilds", eng.rebuilds());
+        j.add("wall_time", wall);
+        j.add("particle_steps_per_second", wall > 0 ? double(eng.steps()) * world.particles.size() / wall : 0.0);
+        j.add("threads", omp_get_max_threads());
+        j.add("peak_rss_bytes", peakRssBytes());
+        writeFileAtomic(dir / "run.json", j.dump() + "\n");
+    };
+
+    const bool tty = !opt.quiet && isatty(STDERR_FILENO);
+    Progress progress(tty, sc.duration);
+    double nextSeries = 0, nextSnap = 0;
+    const double eps = 0.5 * ts.dt;
+    RunStatus status = RunStatus::Completed;
+    std::string statusText = "completed";
+    try {
+        for (;;) {
+            if (world.time + eps >= nextSeries) {
+                writeRow();
+                nextSeries += seriesPeriod;
+            }
+            if (snapPeriod > 0 && world.time + eps >= nextSnap) {
+                snaps.write(world, world.time);
+                series.flush();
+                nextSnap += snapPeriod;
+            }
+            if (world.time + eps >= sc.duration) break;
+            double target = std::min(sc.duration, nextSeries);
+            if (snapPeriod > 0) target = std::min(target, nextSnap);
+            // advance in chunks so the progress line stays live
+            while (world.time + eps < target) {
+                eng.advanceTo(std::min(target, world.time + 200 * ts.dt));
+                progress.update(world.time, eng.steps(), eng.forceStats().contacts);
+            }
+        }
+    } catch (const SimulationError& e) {
+        progress.finish();
+        log << "error: simulation stopped: " << e.what() << "\n";
+        status = RunStatus::BlewUp;
+        statusText = std::string("failed: ") + e.what();
+    }
+    progress.update(world.time, eng.steps(), eng.forceStats().contacts, true);
+    progress.finish();
+    series.flush();
+    writeRunJson(statusText);
+    if (!opt.quiet) {
+        const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+        log << fmt::format("{}: {} particles, {} steps of {:.4g} s, simulated {:.4g} s in {:.2f} s wall time "
+                           "({:.3g} particle-steps/s); outputs in {}\n",
+                           sc.name, world.particles.size(), eng.steps(), ts.dt, world.time, wall,
+                           wall > 0 ? eng.steps() * double(world.particles.size()) / wall : 0.0, dir.string());
+    }
+    return status;
+}
+
+template <int D>
+void describeTdm(const Scenario& sc, std::ostream& out) {
+    World<D> world = buildWorld<D>(sc);
+    std::string dtNote;
+    const TdmSettings ts = tdmSettings<D>(sc, world, &dtNote);
+    TdmEngine<D> eng(world, ts);
+    const std::size_t n = world.particles.size();
+    const std::size_t pairs = eng.pairs().size();
+    // Memory: particle arrays + integrator history + pair list (partner, shift, history, force, torque, index).
+    const std::size_t perParticle = sizeof(Vec<D>) * 4 + sizeof(Ang<D>) * 5 + 8 * 4 + 16 +
+                                    (ts.integrator == IntegratorKind::Gear5 ? 4 * (sizeof(Vec<D>) + sizeof(Ang<D>)) : sizeof(Vec<D>) + sizeof(Ang<D>));
+    const std::size_t perPair = 4 + 1 + sizeof(Vec<D>) * 2 + sizeof(Ang<D>) + 4;
+    const double steps = std::ceil(sc.duration / ts.dt);
+    out << fmt::format("scenario   {} ({})\n", sc.name, sc.path);
+    out << fmt::format("method     tdm, {}D, integrator {}\n", D,
+                       ts.integrator == IntegratorKind::Gear5 ? "gear5" : "verlet");
+    out << fmt::format("particles  {} ({} frozen), {} materials, {} walls\n", n,
+                       std::count_if(world.particles.flags.begin(), world.particles.flags.end(),
+                                     [](std::uint8_t f) { return f & kFrozen; }),
+                       sc.materials.size(), world.walls.size());
+    out << fmt::format("contact    {} normal law, {} tangential; contact duration t_c = {:.4g} s ({})\n",
+                       sc.contact.normal == NormalLaw::Linear ? "linear" : "hertz",
+                       sc.contact.tangential == TangentialLaw::Spring ? "spring" : "no",
+                       world.contact.contactTime, world.contact.contactTimeNote);
+    out << fmt::format("time step  dt = {:.4g} s ({}); {:.0f} steps for {:.4g} s\n", ts.dt, dtNote, steps,
+                       sc.duration);
+    out << fmt::format("neighbours skin {:.4g} m, {} pairs in the initial list\n", ts.skin, pairs);
+    out << fmt::format("memory     about {:.1f} MB ({} bytes per particle)\n",
+                       (n * perParticle + pairs * perPair) / 1e6, n ? (n * perParticle + pairs * perPair) / n : 0);
+    for (std::size_t a = 0; a < sc.materials.size(); ++a)
+        out << fmt::format("material   {}: restitution of the soft law {:.5f} (incl. contact-end rule)\n",
+                           sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+}
+
+}  // namespace
+
+RunStatus runScenario(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
+    if (opt.threads > 0) omp_set_num_threads(opt.threads);
+    if (sc.method != Method::Tdm)
+        throw ScenarioError({sc.path, 0}, "method", "only \"tdm\" is available in this version");
+    return sc.dimension == 2 ? runTdm<2>(sc, opt, log) : runTdm<3>(sc, opt, log);
+}
+
+void describeScenario(const Scenario& sc, std::ostream& out) {
+    if (sc.method != Method::Tdm)
+        throw ScenarioError({sc.path, 0}, "method", "only \"tdm\" is available in this version");
+    if (sc.dimension == 2)
+        describeTdm<2>(sc, out);
+    else
+        describeTdm<3>(sc, out);
+}
+
+}  // namespace haet

@@ -1,0 +1,25 @@
+#pragma once
+// Runs a scenario: builds the world, drives the engine to the requested time, and writes every output
+// (series.csv, VTK snapshots + .pvd, walls, run.json). Writers run at fixed simulated times; the engine only
+// advances. Exit codes of `haet run`: 0 done, 2 bad input, 3 the simulation blew up (outputs so far kept).
+#include <filesystem>
+#include <iosfwd>
+
+#include "scenario/definition.hpp"
+
+namespace haet {
+
+struct RunOptions {
+    std::filesystem::path outDir;  ///< empty: the scenario's [output] directory
+    int threads = 0;               ///< 0: OpenMP default
+    bool quiet = false;            ///< no progress bar and no summary
+};
+
+enum class RunStatus { Completed = 0, BadInput = 2, BlewUp = 3 };
+
+RunStatus runScenario(const Scenario& sc, const RunOptions& opt, std::ostream& log);
+
+/// `haet check`: what the scenario would run (particles, dt and its rule, contact duration, memory estimate).
+void describeScenario(const Scenario& sc, std::ostream& out);
+
+}  // namespace haet

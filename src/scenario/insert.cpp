@@ -1,0 +1,631 @@
+#include "scenario/insert.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string_view>
+
+namespace haet {
+namespace {
+
+std::string insertKey(std::size_t k) { return "insert[" + std::to_string(k + 1) + "]"; }
+
+std::string inQuotes(std::string_view s) { return "\"" + std::string(s) + "\""; }
+
+std::string formatNumber(double v) {
+    std::ostringstream os;
+    os.precision(6);
+    os << v;
+    return os.str();
+}
+
+std::string_view trim(std::string_view s) {
+    const auto first = s.find_first_not_of(" \t\r\n");
+    if (first == std::string_view::npos) return {};
+    const auto last = s.find_last_not_of(" \t\r\n");
+    return s.substr(first, last - first + 1);
+}
+
+std::vector<std::string_view> splitOn(std::string_view s, char sep) {
+    std::vector<std::string_view> out;
+    std::size_t start = 0;
+    while (true) {
+        const auto at = s.find(sep, start);
+        out.push_back(trim(s.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start)));
+        if (at == std::string_view::npos) return out;
+        start = at + 1;
+    }
+}
+
+std::vector<std::string_view> whitespaceTokens(std::string_view s) {
+    std::vector<std::string_view> out;
+    std::size_t i = 0;
+    while (i < s.size()) {
+        while (i < s.size() && (s[i] == ' ' || s[i] == '\t' || s[i] == '\r')) ++i;
+        const std::size_t start = i;
+        while (i < s.size() && s[i] != ' ' && s[i] != '\t' && s[i] != '\r') ++i;
+        if (i > start) out.push_back(s.substr(start, i - start));
+    }
+    return out;
+}
+
+/// A finite number taking the whole of `s` (a leading '+' is allowed), or nothing.
+std::optional<double> parseDouble(std::string_view s) {
+    if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+    double v = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+    return v;
+}
+
+std::optional<long long> parseInteger(std::string_view s) {
+    if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+    long long v = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+    return v;
+}
+
+std::vector<std::string> readLines(const std::filesystem::path& file, const std::string& key) {
+    std::ifstream in(file);
+    if (!in) throw ScenarioError({file.string(), 0}, key, "cannot open the particle file");
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(in, line);) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        lines.push_back(std::move(line));
+    }
+    return lines;
+}
+
+template <int D>
+Vec<D> toVec(const Vec3d& a) {
+    Vec<D> v;
+    for (int k = 0; k < D; ++k) v[k] = a[std::size_t(k)];
+    return v;
+}
+
+/// True when a sphere (disk) of radius r at x lies on the inner side of every wall plane, clear of it by r.
+template <int D>
+bool clearOfWalls(const std::vector<WallDef>& walls, const Vec<D>& x, double r) {
+    for (const WallDef& w : walls) {
+        double dist = 0;
+        for (int k = 0; k < D; ++k) dist += (x[k] - w.point[std::size_t(k)]) * w.normal[std::size_t(k)];
+        if (dist < r) return false;
+    }
+    return true;
+}
+
+/// Linked-cell grid over a box, for the overlap test of a candidate against the particles placed so far.
+/// The cell edge is at least the largest diameter, so a candidate can only overlap particles in the 3^D cells
+/// around its own. Points beyond the box are stored in the border cells (clamped), which keeps that rule true.
+template <int D>
+class OverlapGrid {
+public:
+    /// Box [lo, hi]; `maxRadius` bounds every radius that will be added or tested [m]; `expected` is the number of
+    /// particles that will be added, used to keep the cell count proportional to it.
+    OverlapGrid(const Vec<D>& lo, const Vec<D>& hi, double maxRadius, std::size_t expected) : lo_(lo) {
+        cell_ = 2 * maxRadius;
+        const double cap = std::max(4096.0, std::min(8.0 * double(expected), double(1u << 22)));
+        auto cellCount = [&](double c) {
+            double n = 1;
+            for (int k = 0; k < D; ++k) n *= std::max(1.0, std::ceil((hi[k] - lo[k]) / c));
+            return n;
+        };
+        while (cellCount(cell_) > cap) cell_ *= 1.5;
+        std::size_t total = 1;
+        for (int k = 0; k < D; ++k) {
+            n_[k] = std::max(1, int(std::ceil((hi[k] - lo[k]) / cell_)));
+            total *= std::size_t(n_[k]);
+        }
+        head_.assign(total, kNone);
+    }
+
+    void add(const Vec<D>& x, double r) {
+        const std::size_t c = cellOf(x);
+        x_.push_back(x);
+        r_.push_back(r);
+        next_.push_back(head_[c]);
+        head_[c] = std::uint32_t(x_.size() - 1);
+    }
+
+    bool overlaps(const Vec<D>& x, double r) const {
+        std::array<int, D> base;
+        for (int k = 0; k < D; ++k) base[k] = indexOf(x, k);
+        std::array<int, D> off;
+        off.fill(-1);
+        while (true) {
+            std::size_t c = 0;
+            bool inside = true;
+            for (int k = D - 1; k >= 0; --k) {
+                const int i = base[k] + off[k];
+                if (i < 0 || i >= n_[k]) inside = false;
+                c = c * std::size_t(n_[k]) + std::size_t(std::max(0, i));
+            }
+            if (inside) {
+                for (std::uint32_t j = head_[c]; j != kNone; j = next_[j]) {
+                    const double reach = r + r_[j];
+                    // Touching (distance equal to the sum of radii, up to rounding) is allowed: a lattice of
+                    // spacing 2r touches exactly.
+                    if (norm2(x - x_[j]) < reach * reach * (1 - 1e-12)) return true;
+                }
+            }
+            int k = 0;
+            while (k < D && off[k] == 1) off[k++] = -1;
+            if (k == D) return false;
+            ++off[k];
+        }
+    }
+
+private:
+    static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+    int indexOf(const Vec<D>& x, int k) const {
+        const double f = std::floor((x[k] - lo_[k]) / cell_);
+        return int(std::clamp(f, 0.0, double(n_[k] - 1)));
+    }
+    std::size_t cellOf(const Vec<D>& x) const {
+        std::size_t c = 0;
+        for (int k = D - 1; k >= 0; --k) c = c * std::size_t(n_[k]) + std::size_t(indexOf(x, k));
+        return c;
+    }
+
+    Vec<D> lo_;
+    double cell_;
+    std::array<int, D> n_{};
+    std::vector<std::uint32_t> head_;
+    std::vector<std::uint32_t> next_;
+    std::vector<Vec<D>> x_;
+    std::vector<double> r_;
+};
+
+/// A particle about to be added to the store.
+template <int D>
+struct NewParticle {
+    Vec<D> x{};
+    Vec<D> v{};
+    Ang<D> w{};
+    double radius = 0;
+    double density = 0;  ///< [kg/m^3] (2D: [kg/m^2])
+    std::uint16_t material = 0;
+    std::uint8_t flags = 0;
+    Vec<D> image{};
+};
+
+/// A grid over the insert's region, expanded by one cell, holding the store's particles that could touch it.
+template <int D>
+OverlapGrid<D> gridWithExisting(const Particles<D>& store, const Vec<D>& lo, const Vec<D>& hi, double radiusMax,
+                                std::size_t expected) {
+    double maxR = radiusMax;
+    for (double r : store.radius) maxR = std::max(maxR, r);
+    const double margin = 2 * maxR;  // farther than this from the region, nothing can overlap a new particle
+    OverlapGrid<D> grid(lo - Vec<D>::filled(margin), hi + Vec<D>::filled(margin), maxR, store.size() + expected);
+    for (std::size_t i = 0; i < store.size(); ++i) {
+        bool near = true;
+        for (int k = 0; k < D; ++k) near = near && store.x[i][k] >= lo[k] - margin && store.x[i][k] <= hi[k] + margin;
+        if (near) grid.add(store.x[i], store.radius[i]);
+    }
+    return grid;
+}
+
+/// Velocities of a lattice or random insert: the mean `velocity` plus, when temperature > 0, a Maxwellian with
+/// variance `temperature` per component whose net momentum is then removed, so the insert moves with `velocity`.
+/// Frozen particles get `velocity` alone.
+template <int D>
+void assignVelocities(const InsertDef& in, std::vector<NewParticle<D>>& out, Rng& rng) {
+    const Vec<D> mean = toVec<D>(in.velocity);
+    const double sigma = std::sqrt(in.temperature);
+    const bool thermal = in.temperature > 0 && !in.frozen;
+    for (auto& p : out) {
+        p.v = mean;
+        if (thermal)
+            for (int k = 0; k < D; ++k) p.v[k] += sigma * rng.normal();
+    }
+    if (!thermal || out.empty()) return;
+    Vec<D> momentum = Vec<D>::zero();  // of the thermal part [kg m/s]
+    double massSum = 0;
+    for (const auto& p : out) {
+        const double m = p.density * Particles<D>::volumeOf(p.radius);
+        momentum += m * (p.v - mean);
+        massSum += m;
+    }
+    const Vec<D> drift = momentum / massSum;
+    for (auto& p : out) p.v -= drift;
+}
+
+template <int D>
+std::vector<NewParticle<D>> insertLattice(const Scenario& s, std::size_t k, const Particles<D>& store, Rng& rng) {
+    const InsertDef& in = s.inserts[k];
+    const double spacing = in.spacing.value_or(2 * in.radiusMax);
+    if (!(spacing >= 2 * in.radiusMax))
+        throw ScenarioError(
+            in.pos, insertKey(k) + ".spacing",
+            "lattice overlaps: spacing " + formatNumber(spacing) + " < 2 x radius " + formatNumber(2 * in.radiusMax));
+    const Vec<D> lo = toVec<D>(in.regionLo), hi = toVec<D>(in.regionHi);
+    std::array<std::uint64_t, D> n{};
+    for (int a = 0; a < D; ++a) {
+        const double room = hi[a] - lo[a] - 2 * in.radiusMax;  // span available to centres [m]
+        // The small tolerance keeps a site that lands on the far edge up to rounding.
+        n[a] = room < 0 ? 0 : std::uint64_t(std::floor(room / spacing + 1e-9)) + 1;
+    }
+    OverlapGrid<D> grid = gridWithExisting(store, lo, hi, in.radiusMax, in.count);
+    const MaterialDef& mat = s.materials[std::size_t(in.material)];
+    std::vector<NewParticle<D>> out;
+    std::array<std::uint64_t, D> site{};  // axis 0 runs fastest, so a lattice under gravity fills from the bottom up
+    bool sitesLeft = true;
+    for (int a = 0; a < D; ++a) sitesLeft = sitesLeft && n[a] > 0;
+    while (sitesLeft && out.size() < in.count) {
+        NewParticle<D> p;
+        for (int a = 0; a < D; ++a)
+            p.x[a] = std::min(lo[a] + in.radiusMax + double(site[a]) * spacing, hi[a] - in.radiusMax);
+        p.radius = rng.uniform(in.radiusMin, in.radiusMax);
+        if (clearOfWalls(s.walls, p.x, p.radius) && !grid.overlaps(p.x, p.radius)) {
+            p.density = mat.density;
+            p.material = std::uint16_t(in.material);
+            p.flags = in.frozen ? kFrozen : 0;
+            out.push_back(p);
+        }
+        int a = 0;
+        while (a < D && ++site[a] == n[a]) site[a++] = 0;
+        sitesLeft = a < D;
+    }
+    assignVelocities(in, out, rng);
+    return out;
+}
+
+template <int D>
+std::vector<NewParticle<D>> insertRandom(const Scenario& s, std::size_t k, const Particles<D>& store, Rng& rng) {
+    const InsertDef& in = s.inserts[k];
+    const Vec<D> lo = toVec<D>(in.regionLo), hi = toVec<D>(in.regionHi);
+    OverlapGrid<D> grid = gridWithExisting(store, lo, hi, in.radiusMax, in.count);
+    const MaterialDef& mat = s.materials[std::size_t(in.material)];
+    // Random sequential addition slows down sharply near its jamming limit (~0.38 volume fraction in 3D, ~0.55 area
+    // fraction in 2D); these bounds end a hopeless insert in well under a second instead of running on.
+    const std::uint64_t maxConsecutive = 20000;
+    const std::uint64_t maxTotal = 200 * std::uint64_t(in.count) + 100000;
+    std::uint64_t attempts = 0;
+    std::vector<NewParticle<D>> out;
+    out.reserve(in.count);
+    for (std::size_t i = 0; i < in.count; ++i) {
+        NewParticle<D> p;
+        p.radius = rng.uniform(in.radiusMin, in.radiusMax);
+        bool placed = false;
+        for (std::uint64_t tries = 0; tries < maxConsecutive && attempts < maxTotal && !placed; ++tries) {
+            ++attempts;
+            for (int a = 0; a < D; ++a) p.x[a] = lo[a] + p.radius + (hi[a] - lo[a] - 2 * p.radius) * rng.uniform();
+            placed = clearOfWalls(s.walls, p.x, p.radius) && !grid.overlaps(p.x, p.radius);
+        }
+        if (!placed)
+            throw ScenarioError(in.pos, insertKey(k) + ".count",
+                                "could not place " + std::to_string(in.count) +
+                                    " particles without overlap: region too small (placed " + std::to_string(i) +
+                                    " in " + std::to_string(attempts) + " attempts)");
+        grid.add(p.x, p.radius);
+        p.density = mat.density;
+        p.material = std::uint16_t(in.material);
+        p.flags = in.frozen ? kFrozen : 0;
+        out.push_back(p);
+    }
+    assignVelocities(in, out, rng);
+    return out;
+}
+
+template <int D>
+std::vector<NewParticle<D>> insertFromFile(const Scenario& s, std::size_t k) {
+    const InsertDef& in = s.inserts[k];
+    const std::string key = insertKey(k) + ".file";
+    const ParticleFile pf =
+        in.format == FileFormat::Csv ? readParticleCsv(in.file, D, s.materials, key) : readLammpsData(in.file, key);
+    std::vector<NewParticle<D>> out;
+    out.reserve(pf.particles.size());
+    for (const FileParticle& fp : pf.particles) {
+        NewParticle<D> p;
+        p.x = toVec<D>(fp.x);
+        for (int a = 0; a < D; ++a)
+            if (p.x[a] < s.domain.lo[std::size_t(a)] || p.x[a] > s.domain.hi[std::size_t(a)])
+                throw ScenarioError({in.file, fp.line}, key, "particle centre lies outside the domain");
+        p.v = toVec<D>(fp.v);
+        if constexpr (D == 3) {
+            p.w = toVec<3>(fp.w);
+        } else {
+            p.w[0] = fp.w[2];
+        }
+        p.radius = fp.radius;
+        int mat = in.material;
+        if (fp.material >= 0) mat = fp.material;
+        if (fp.type > 0 && std::size_t(fp.type) <= s.materials.size()) mat = fp.type - 1;
+        p.material = std::uint16_t(mat);
+        if (fp.density) {
+            // LAMMPS computes mass = density (4/3) pi r^3 in 2D as well; the areal density keeps that mass.
+            p.density = (D == 3) ? *fp.density : *fp.density * (4.0 / 3.0) * fp.radius;
+        } else {
+            p.density = s.materials[std::size_t(mat)].density;
+        }
+        p.flags = (in.frozen || fp.frozen) ? kFrozen : 0;
+        if (pf.boxLo && pf.boxHi)
+            for (int a = 0; a < D; ++a)
+                p.image[a] = fp.image[std::size_t(a)] * ((*pf.boxHi)[std::size_t(a)] - (*pf.boxLo)[std::size_t(a)]);
+        out.push_back(p);
+    }
+    return out;
+}
+
+}  // namespace
+
+ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
+                             const std::vector<MaterialDef>& materials, const std::string& key) {
+    const std::string name = file.string();
+    const std::vector<std::string> lines = readLines(file, key);
+    enum Column { X, Y, Z, Radius, Vx, Vy, Vz, Material, Frozen, kColumns };
+    const char* const columnName[kColumns] = {"x", "y", "z", "radius", "vx", "vy", "vz", "material", "frozen"};
+    std::array<int, kColumns> col;
+    col.fill(-1);
+    std::size_t fields = 0;
+    bool haveHeader = false;
+    ParticleFile out;
+
+    for (std::size_t li = 0; li < lines.size(); ++li) {
+        const int lineNo = int(li + 1);
+        const std::string_view line = trim(lines[li]);
+        if (line.empty() || line[0] == '#') continue;
+        auto fail = [&](const std::string& what) { throw ScenarioError({name, lineNo}, key, what); };
+        const std::vector<std::string_view> cells = splitOn(line, ',');
+
+        if (!haveHeader) {
+            haveHeader = true;
+            fields = cells.size();
+            for (std::size_t c = 0; c < cells.size(); ++c) {
+                int which = -1;
+                for (int j = 0; j < kColumns; ++j)
+                    if (cells[c] == columnName[j]) which = j;
+                if (which < 0)
+                    fail("unknown column " + inQuotes(cells[c]) +
+                         " (the header names columns x, y, z, radius, vx, vy, vz, material, frozen)");
+                if (col[std::size_t(which)] >= 0) fail("column " + inQuotes(cells[c]) + " appears twice");
+                if (dimension == 2 && (which == Z || which == Vz))
+                    fail("column " + inQuotes(cells[c]) + " is not used in a 2D scenario");
+                col[std::size_t(which)] = int(c);
+            }
+            for (int j : {int(X), int(Y), int(Z), int(Radius)}) {
+                if (j == Z && dimension == 2) continue;
+                if (col[std::size_t(j)] < 0) fail(std::string("missing column ") + inQuotes(columnName[j]));
+            }
+            const bool anyV = col[Vx] >= 0 || col[Vy] >= 0 || col[Vz] >= 0;
+            const bool allV = col[Vx] >= 0 && col[Vy] >= 0 && (dimension == 2 || col[Vz] >= 0);
+            if (anyV && !allV)
+                fail(dimension == 3 ? "velocity columns vx, vy, vz go together"
+                                    : "velocity columns vx, vy go together");
+            continue;
+        }
+
+        if (cells.size() != fields)
+            fail("expected " + std::to_string(fields) + " fields, got " + std::to_string(cells.size()));
+        FileParticle p;
+        p.line = lineNo;
+        auto number = [&](Column c) {
+            const std::string_view text = cells[std::size_t(col[c])];
+            const auto v = parseDouble(text);
+            if (!v) fail(std::string("column ") + columnName[c] + ": expected a number, got " + inQuotes(text));
+            return *v;
+        };
+        p.x[0] = number(X);
+        p.x[1] = number(Y);
+        if (dimension == 3) p.x[2] = number(Z);
+        p.radius = number(Radius);
+        if (!(p.radius > 0)) fail("column radius: must be > 0");
+        if (col[Vx] >= 0) {
+            p.v[0] = number(Vx);
+            p.v[1] = number(Vy);
+            if (dimension == 3) p.v[2] = number(Vz);
+        }
+        if (col[Material] >= 0) {
+            const std::string_view text = cells[std::size_t(col[Material])];
+            for (std::size_t m = 0; m < materials.size(); ++m)
+                if (materials[m].name == text) p.material = int(m);
+            if (p.material < 0) {
+                const auto idx = parseInteger(text);
+                if (idx && *idx >= 0 && std::size_t(*idx) < materials.size()) p.material = int(*idx);
+            }
+            if (p.material < 0) fail("column material: unknown material " + inQuotes(text));
+        }
+        if (col[Frozen] >= 0) {
+            const std::string_view text = cells[std::size_t(col[Frozen])];
+            if (text == "1" || text == "true")
+                p.frozen = true;
+            else if (text == "0" || text == "false")
+                p.frozen = false;
+            else
+                fail("column frozen: expected 0, 1, true or false, got " + inQuotes(text));
+        }
+        out.particles.push_back(p);
+    }
+    if (!haveHeader) throw ScenarioError({name, 0}, key, "empty particle file: no header line");
+    if (out.particles.empty()) throw ScenarioError({name, int(lines.size())}, key, "the file holds no particles");
+    return out;
+}
+
+ParticleFile readLammpsData(const std::filesystem::path& file, const std::string& key) {
+    const std::string name = file.string();
+    const std::vector<std::string> lines = readLines(file, key);
+    ParticleFile out;
+    // LAMMPS's default box when the header gives none.
+    Vec3d lo{-0.5, -0.5, -0.5}, hi{0.5, 0.5, 0.5};
+    std::optional<long long> atomCount;
+    enum class Section { Header, Atoms, Velocities, Skip } section = Section::Header;
+    bool sawAtoms = false;
+    std::map<long long, std::size_t> indexOfId;
+    const char* const boxWords[3][2] = {{"xlo", "xhi"}, {"ylo", "yhi"}, {"zlo", "zhi"}};
+
+    // The first line is a title and is skipped, as LAMMPS does.
+    for (std::size_t li = 1; li < lines.size(); ++li) {
+        const int lineNo = int(li + 1);
+        auto fail = [&](const std::string& what) { throw ScenarioError({name, lineNo}, key, what); };
+        const std::string_view raw = lines[li];
+        const auto hash = raw.find('#');
+        const std::string_view body = trim(raw.substr(0, hash));
+        const std::string_view comment =
+            hash == std::string_view::npos ? std::string_view{} : trim(raw.substr(hash + 1));
+        if (body.empty()) continue;
+        const std::vector<std::string_view> tok = whitespaceTokens(body);
+        const char lead = tok[0][0];
+        const bool isKeyword = std::isalpha(static_cast<unsigned char>(lead));
+
+        if (isKeyword) {
+            if (body == "Atoms") {
+                if (sawAtoms) fail("second Atoms section");
+                if (!comment.empty() && comment != "sphere")
+                    fail("atom style " + inQuotes(comment) +
+                         " is not supported: write the file with atom_style sphere");
+                section = Section::Atoms;
+                sawAtoms = true;
+            } else if (body == "Velocities") {
+                section = Section::Velocities;
+            } else if (body == "Masses") {
+                section = Section::Skip;  // atom_style sphere takes masses from diameter and density
+            } else {
+                fail("section " + inQuotes(body) +
+                     " is not supported (atom_style sphere files have Atoms and Velocities)");
+            }
+            continue;
+        }
+
+        switch (section) {
+            case Section::Header: {
+                if (tok.size() == 2 && tok[1] == "atoms") {
+                    atomCount = parseInteger(tok[0]);
+                    if (!atomCount || *atomCount < 0) fail("bad atom count " + inQuotes(tok[0]));
+                    continue;
+                }
+                if (tok.size() == 3 && tok[1] == "atom" && tok[2] == "types") {
+                    const auto n = parseInteger(tok[0]);
+                    if (!n || *n < 1) fail("bad atom type count " + inQuotes(tok[0]));
+                    out.atomTypes = int(*n);
+                    continue;
+                }
+                bool boxLine = false;
+                for (int a = 0; a < 3; ++a) {
+                    if (tok.size() == 4 && tok[2] == boxWords[a][0] && tok[3] == boxWords[a][1]) {
+                        const auto l = parseDouble(tok[0]), h = parseDouble(tok[1]);
+                        if (!l || !h || !(*h > *l))
+                            fail(std::string("bad box bounds ") + boxWords[a][0] + " " + boxWords[a][1]);
+                        lo[std::size_t(a)] = *l;
+                        hi[std::size_t(a)] = *h;
+                        boxLine = true;
+                    }
+                }
+                if (boxLine) continue;
+                if (tok.size() == 6 && tok[3] == "xy") fail("triclinic boxes are not supported");
+                // Other header counts (bonds, ellipsoids, ...) are harmless when zero.
+                const auto n = parseInteger(tok[0]);
+                if (n && *n == 0) continue;
+                fail("unsupported header line " + inQuotes(body));
+                continue;
+            }
+            case Section::Atoms: {
+                if (tok.size() != 7 && tok.size() != 10)
+                    fail("Atoms line: expected 7 or 10 values (id type diameter density x y z [ix iy iz]), got " +
+                         std::to_string(tok.size()));
+                FileParticle p;
+                p.line = lineNo;
+                const auto id = parseInteger(tok[0]);
+                const auto type = parseInteger(tok[1]);
+                if (!id) fail("Atoms line: bad atom id " + inQuotes(tok[0]));
+                if (!type || *type < 1) fail("Atoms line: atom type must be an integer >= 1, got " + inQuotes(tok[1]));
+                if (out.atomTypes > 0 && *type > out.atomTypes)
+                    fail("Atoms line: atom type " + std::to_string(*type) + " > atom types " +
+                         std::to_string(out.atomTypes));
+                std::array<double, 5> val{};  // diameter, density, x, y, z
+                for (std::size_t c = 0; c < 5; ++c) {
+                    const auto v = parseDouble(tok[c + 2]);
+                    if (!v) fail("Atoms line: expected a number, got " + inQuotes(tok[c + 2]));
+                    val[c] = *v;
+                }
+                if (!(val[0] > 0)) fail("Atoms line: diameter must be > 0");
+                if (!(val[1] > 0)) fail("Atoms line: density must be > 0");
+                p.type = int(*type);
+                p.radius = 0.5 * val[0];
+                p.density = val[1];
+                p.x = {val[2], val[3], val[4]};
+                if (tok.size() == 10) {
+                    for (std::size_t c = 0; c < 3; ++c) {
+                        const auto f = parseInteger(tok[c + 7]);
+                        if (!f) fail("Atoms line: image flag must be an integer, got " + inQuotes(tok[c + 7]));
+                        p.image[c] = int(*f);
+                    }
+                }
+                if (!indexOfId.emplace(*id, out.particles.size()).second)
+                    fail("Atoms line: atom id " + std::to_string(*id) + " appears twice");
+                out.particles.push_back(p);
+                continue;
+            }
+            case Section::Velocities: {
+                if (tok.size() != 7)
+                    fail("Velocities line: expected 7 values (id vx vy vz wx wy wz), got " +
+                         std::to_string(tok.size()));
+                const auto id = parseInteger(tok[0]);
+                if (!id) fail("Velocities line: bad atom id " + inQuotes(tok[0]));
+                const auto it = indexOfId.find(*id);
+                if (it == indexOfId.end()) fail("Velocities line: no atom with id " + std::to_string(*id));
+                std::array<double, 6> val{};
+                for (std::size_t c = 0; c < 6; ++c) {
+                    const auto v = parseDouble(tok[c + 1]);
+                    if (!v) fail("Velocities line: expected a number, got " + inQuotes(tok[c + 1]));
+                    val[c] = *v;
+                }
+                FileParticle& p = out.particles[it->second];
+                p.v = {val[0], val[1], val[2]};
+                p.w = {val[3], val[4], val[5]};
+                continue;
+            }
+            case Section::Skip:
+                continue;
+        }
+    }
+    if (!atomCount) throw ScenarioError({name, 0}, key, "missing header line \"N atoms\"");
+    if (std::size_t(*atomCount) != out.particles.size())
+        throw ScenarioError({name, 0}, key,
+                            "header says " + std::to_string(*atomCount) + " atoms, the Atoms section has " +
+                                std::to_string(out.particles.size()));
+    if (out.particles.empty()) throw ScenarioError({name, 0}, key, "the file holds no particles");
+    out.boxLo = lo;
+    out.boxHi = hi;
+    return out;
+}
+
+template <int D>
+void insertParticles(const Scenario& s, Particles<D>& particles, Rng rng) {
+    if (s.dimension != D)
+        throw std::invalid_argument("insertParticles: scenario dimension " + std::to_string(s.dimension) +
+                                    " does not match the particle store's " + std::to_string(D));
+    for (std::size_t k = 0; k < s.inserts.size(); ++k) {
+        std::vector<NewParticle<D>> out;
+        switch (s.inserts[k].arrangement) {
+            case Arrangement::Lattice:
+                out = insertLattice(s, k, particles, rng);
+                break;
+            case Arrangement::Random:
+                out = insertRandom(s, k, particles, rng);
+                break;
+            case Arrangement::File:
+                out = insertFromFile<D>(s, k);
+                break;
+        }
+        // Added only once the whole insert succeeded, so a failed insert leaves no partial block behind.
+        for (const auto& p : out) {
+            const std::size_t i =
+                particles.add(p.x, p.v, p.w, p.radius, p.density, p.material, particles.size(), p.flags);
+            particles.image[i] = p.image;
+        }
+    }
+}
+
+template void insertParticles<2>(const Scenario&, Particles<2>&, Rng);
+template void insertParticles<3>(const Scenario&, Particles<3>&, Rng);
+
+}  // namespace haet

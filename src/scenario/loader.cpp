@@ -1,0 +1,570 @@
+#include "scenario/loader.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <optional>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include <toml++/toml.h>
+
+namespace haet {
+namespace {
+
+const char* const kAxisName[3] = {"x", "y", "z"};
+
+std::string inQuotes(std::string_view s) { return "\"" + std::string(s) + "\""; }
+
+std::string formatNumber(double v) {
+    std::ostringstream os;
+    os.precision(6);
+    os << v;
+    return os.str();
+}
+
+/// Reads the values of one TOML table and knows the dotted key path of each, so that every error names the key
+/// and the line it came from (the value's line, or the table's when the key is missing).
+class TableReader {
+public:
+    TableReader(const toml::table& table, std::string path, std::string file)
+        : table_(table), path_(std::move(path)), file_(std::move(file)) {}
+
+    const std::string& path() const { return path_; }
+    const std::string& file() const { return file_; }
+    const toml::table& table() const { return table_; }
+
+    std::string keyPath(std::string_view key) const {
+        return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+    }
+    SourcePos tablePos() const { return {file_, int(table_.source().begin.line)}; }
+    SourcePos posOf(std::string_view key) const {
+        if (const toml::node* n = table_.get(key)) return {file_, int(n->source().begin.line)};
+        return tablePos();
+    }
+    bool has(std::string_view key) const { return table_.contains(key); }
+
+    [[noreturn]] void fail(std::string_view key, const std::string& what) const {
+        throw ScenarioError(posOf(key), keyPath(key), what);
+    }
+    [[noreturn]] void failTable(const std::string& what) const { throw ScenarioError(tablePos(), path_, what); }
+
+    /// Rejects any key not in `allowed`; reports the first one in file order so the message is stable.
+    void allowOnly(std::initializer_list<std::string_view> allowed) const {
+        const toml::key* first = nullptr;
+        for (auto&& [k, v] : table_) {
+            if (std::find(allowed.begin(), allowed.end(), std::string_view(k.str())) != allowed.end()) continue;
+            if (!first || k.source().begin.line < first->source().begin.line) first = &k;
+        }
+        if (first) throw ScenarioError({file_, int(first->source().begin.line)}, keyPath(first->str()), "unknown key");
+    }
+
+    /// Rejects `key` when present: it does not apply in this configuration (`why` says which one would need it).
+    void forbid(std::string_view key, const std::string& why) const {
+        if (has(key)) fail(key, why);
+    }
+
+    std::optional<double> number(std::string_view key) const {
+        const toml::node* n = table_.get(key);
+        if (!n) return std::nullopt;
+        const std::optional<double> v = asNumber(*n);
+        if (!v) fail(key, "expected a number");
+        if (!std::isfinite(*v)) fail(key, "must be finite");
+        return v;
+    }
+    double requiredNumber(std::string_view key) const {
+        const auto v = number(key);
+        if (!v) fail(key, "is required");
+        return *v;
+    }
+
+    std::optional<std::int64_t> integer(std::string_view key) const {
+        const toml::node* n = table_.get(key);
+        if (!n) return std::nullopt;
+        if (const auto* i = n->as_integer()) return i->get();
+        fail(key, "expected an integer");
+    }
+
+    std::optional<std::string> string(std::string_view key) const {
+        const toml::node* n = table_.get(key);
+        if (!n) return std::nullopt;
+        if (const auto* s = n->as_string()) return s->get();
+        fail(key, "expected a string");
+    }
+    std::string requiredString(std::string_view key) const {
+        auto s = string(key);
+        if (!s) fail(key, "is required");
+        return *s;
+    }
+
+    std::optional<bool> boolean(std::string_view key) const {
+        const toml::node* n = table_.get(key);
+        if (!n) return std::nullopt;
+        if (const auto* b = n->as_boolean()) return b->get();
+        fail(key, "expected a boolean (true or false)");
+    }
+
+    /// An array of exactly `dim` numbers; components beyond `dim` are zero.
+    std::optional<Vec3d> vector(std::string_view key, int dim) const {
+        const toml::node* n = table_.get(key);
+        if (!n) return std::nullopt;
+        const std::string expected = "expected an array of " + std::to_string(dim) + " numbers";
+        const toml::array* a = n->as_array();
+        if (!a || int(a->size()) != dim) fail(key, expected);
+        Vec3d out{0, 0, 0};
+        for (int k = 0; k < dim; ++k) {
+            const auto v = asNumber(*a->get(std::size_t(k)));
+            if (!v) fail(key, expected);
+            if (!std::isfinite(*v)) fail(key, "must be finite");
+            out[std::size_t(k)] = *v;
+        }
+        return out;
+    }
+    Vec3d requiredVector(std::string_view key, int dim) const {
+        auto v = vector(key, dim);
+        if (!v) fail(key, "is required");
+        return *v;
+    }
+
+    std::optional<std::array<bool, 3>> booleans(std::string_view key, int dim) const {
+        const toml::node* n = table_.get(key);
+        if (!n) return std::nullopt;
+        const std::string expected = "expected an array of " + std::to_string(dim) + " booleans";
+        const toml::array* a = n->as_array();
+        if (!a || int(a->size()) != dim) fail(key, expected);
+        std::array<bool, 3> out{false, false, false};
+        for (int k = 0; k < dim; ++k) {
+            const auto* b = a->get(std::size_t(k))->as_boolean();
+            if (!b) fail(key, expected);
+            out[std::size_t(k)] = b->get();
+        }
+        return out;
+    }
+
+    /// A string that must be one of `options`; returns the matching value.
+    template <class E>
+    std::optional<E> choice(std::string_view key, std::initializer_list<std::pair<std::string_view, E>> options) const {
+        const auto s = string(key);
+        if (!s) return std::nullopt;
+        for (const auto& [name, value] : options)
+            if (*s == name) return value;
+        std::string list;
+        for (const auto& [name, value] : options) list += (list.empty() ? "" : ", ") + inQuotes(name);
+        fail(key, "must be one of " + list + " (got " + inQuotes(*s) + ")");
+    }
+
+    const toml::table* subTable(std::string_view key) const {
+        const toml::node* n = table_.get(key);
+        if (!n) return nullptr;
+        if (const auto* t = n->as_table()) return t;
+        fail(key, "expected a table");
+    }
+
+    /// An array whose every element is a table ([[key]] blocks, or an inline array of inline tables).
+    const toml::array* arrayOfTables(std::string_view key) const {
+        const toml::node* n = table_.get(key);
+        if (!n) return nullptr;
+        const toml::array* a = n->as_array();
+        if (!a || !a->is_array_of_tables()) fail(key, "expected an array of tables ([[" + std::string(key) + "]])");
+        return a;
+    }
+
+private:
+    static std::optional<double> asNumber(const toml::node& n) {
+        if (const auto* i = n.as_integer()) return double(i->get());
+        if (const auto* f = n.as_floating_point()) return f->get();
+        return std::nullopt;
+    }
+
+    const toml::table& table_;
+    std::string path_;
+    std::string file_;
+};
+
+/// Stand-in for an optional table that is absent, so its defaults are read through the same code.
+const toml::table& emptyTable() {
+    static const toml::table empty;
+    return empty;
+}
+
+class Loader {
+public:
+    Loader(const toml::table& root, std::string file, std::filesystem::path dir)
+        : root_(root, "", file), file_(std::move(file)), dir_(std::move(dir)) {}
+
+    Scenario load() {
+        root_.allowOnly({"name", "dimension", "method", "duration", "seed", "domain", "materials", "contact", "tdm",
+                         "walls", "insert", "output"});
+        Scenario s;
+        s.path = file_;
+        readTop(s);
+        readDomain(s);
+        readMaterials(s);
+        readContact(s);
+        readTdm(s);
+        readWalls(s);
+        readInserts(s);
+        readOutput(s);
+        return s;
+    }
+
+private:
+    TableReader child(std::string_view key) const {
+        const toml::table* t = root_.subTable(key);
+        return TableReader(t ? *t : emptyTable(), std::string(key), file_);
+    }
+
+    void readTop(Scenario& s) {
+        s.name = root_.requiredString("name");
+        if (s.name.empty()) root_.fail("name", "must not be empty");
+
+        const auto dim = root_.integer("dimension");
+        if (!dim) root_.fail("dimension", "is required");
+        if (*dim != 2 && *dim != 3) root_.fail("dimension", "must be 2 or 3");
+        s.dimension = int(*dim);
+        dim_ = s.dimension;
+
+        s.method = root_.choice<Method>("method", {{"tdm", Method::Tdm}, {"edm", Method::Edm}, {"haet", Method::Haet}})
+                       .value_or(Method::Tdm);
+
+        s.duration = root_.requiredNumber("duration");
+        if (!(s.duration > 0)) root_.fail("duration", "must be > 0");
+
+        if (const auto seed = root_.integer("seed")) {
+            if (*seed < 0) root_.fail("seed", "must be >= 0");
+            s.seed = std::uint64_t(*seed);
+        }
+    }
+
+    void readDomain(Scenario& s) {
+        if (!root_.has("domain")) root_.fail("domain", "is required");
+        const TableReader r = child("domain");
+        r.allowOnly({"lo", "hi", "periodic", "gravity"});
+        DomainDef& d = s.domain;
+        d.lo = r.requiredVector("lo", dim_);
+        d.hi = r.requiredVector("hi", dim_);
+        for (int k = 0; k < dim_; ++k)
+            if (!(d.hi[k] > d.lo[k]))
+                r.fail("hi", std::string("must be > lo on every axis (axis ") + kAxisName[k] + ": hi " +
+                                 formatNumber(d.hi[k]) + " <= lo " + formatNumber(d.lo[k]) + ")");
+        d.periodic = r.booleans("periodic", dim_).value_or(std::array<bool, 3>{false, false, false});
+        d.gravity = r.vector("gravity", dim_).value_or(Vec3d{0, 0, 0});
+        domain_ = d;
+    }
+
+    void readMaterials(Scenario& s) {
+        if (!root_.has("materials")) root_.fail("materials", "at least one [materials.NAME] table is required");
+        const TableReader all = child("materials");
+        // Materials are numbered in file order (LAMMPS atom type k is material k-1); toml++ keeps keys sorted.
+        std::vector<std::pair<const toml::key*, const toml::node*>> entries;
+        for (auto&& [k, v] : all.table()) entries.emplace_back(&k, &v);
+        std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+            return a.first->source().begin.line < b.first->source().begin.line;
+        });
+        if (entries.empty()) all.failTable("at least one [materials.NAME] table is required");
+        if (entries.size() > 65535) all.failTable("at most 65535 materials");
+
+        for (const auto& [key, node] : entries) {
+            const toml::table* t = node->as_table();
+            if (!t) all.fail(key->str(), "expected a table ([materials." + std::string(key->str()) + "])");
+            const TableReader r(*t, all.keyPath(key->str()), file_);
+            r.allowOnly({"density", "young", "poisson", "restitution", "friction", "tangential_restitution",
+                         "dissipation_time"});
+            MaterialDef m;
+            m.name = key->str();
+            m.pos = r.tablePos();
+            m.density = r.requiredNumber("density");
+            if (!(m.density > 0)) r.fail("density", "must be > 0");
+            m.young = r.number("young").value_or(m.young);
+            if (!(m.young > 0)) r.fail("young", "must be > 0");
+            m.poisson = r.number("poisson").value_or(m.poisson);
+            if (!(m.poisson > -1 && m.poisson < 0.5)) r.fail("poisson", "must satisfy -1 < poisson < 0.5");
+            m.restitution = r.requiredNumber("restitution");
+            if (!(m.restitution > 0 && m.restitution <= 1)) r.fail("restitution", "must satisfy 0 < e <= 1");
+            m.friction = r.requiredNumber("friction");
+            if (!(m.friction >= 0)) r.fail("friction", "must be >= 0");
+            m.tangentialRestitution = r.number("tangential_restitution").value_or(m.tangentialRestitution);
+            if (!(m.tangentialRestitution >= -1 && m.tangentialRestitution <= 1))
+                r.fail("tangential_restitution", "must satisfy -1 <= beta0 <= 1");
+            m.dissipationTime = r.number("dissipation_time");
+            if (m.dissipationTime && !(*m.dissipationTime > 0)) r.fail("dissipation_time", "must be > 0");
+            s.materials.push_back(std::move(m));
+        }
+        materials_ = &s.materials;
+    }
+
+    /// Index of the material named by `key` (a required string).
+    int materialIndex(const TableReader& r, std::string_view key) const {
+        const std::string name = r.requiredString(key);
+        for (std::size_t i = 0; i < materials_->size(); ++i)
+            if ((*materials_)[i].name == name) return int(i);
+        r.fail(key, "unknown material " + inQuotes(name) + " (no [materials." + name + "] table)");
+    }
+
+    void readContact(Scenario& s) {
+        const TableReader r = child("contact");
+        r.allowOnly({"normal", "duration", "kn", "gamma_n", "damping", "tangential", "kt", "kt_ratio", "gamma_t",
+                     "attraction", "impact_velocity"});
+        ContactDef& c = s.contact;
+        c.pos = r.tablePos();
+        c.normal = r.choice<NormalLaw>("normal", {{"linear", NormalLaw::Linear}, {"hertz", NormalLaw::Hertz}})
+                       .value_or(NormalLaw::Linear);
+        if (c.normal == NormalLaw::Linear) {
+            c.duration = r.number("duration");
+            c.kn = r.number("kn");
+            c.gammaN = r.number("gamma_n");
+            if (c.duration && c.kn) r.fail("kn", "not together with duration (give one of them)");
+            if (!c.duration && !c.kn)
+                r.fail("duration", "the linear law needs a contact duration (or kn); neither is given");
+            if (c.duration && !(*c.duration > 0)) r.fail("duration", "must be > 0");
+            if (c.kn && !(*c.kn > 0)) r.fail("kn", "must be > 0");
+            if (c.gammaN && !c.kn)
+                r.fail("gamma_n", "only together with kn (with duration, damping follows from restitution)");
+            if (c.gammaN && !(*c.gammaN >= 0)) r.fail("gamma_n", "must be >= 0");
+            r.forbid("damping", "only for normal = \"hertz\"");
+        } else {
+            const std::string why = "only for normal = \"linear\"";
+            r.forbid("duration", why + " (the Hertz contact duration follows from impact_velocity)");
+            r.forbid("kn", why);
+            r.forbid("gamma_n", why);
+            c.hertzDamping = r.choice<HertzDamping>("damping", {{"none", HertzDamping::None},
+                                                                {"viscoelastic", HertzDamping::Viscoelastic},
+                                                                {"tsuji", HertzDamping::Tsuji}})
+                                 .value_or(HertzDamping::Viscoelastic);
+        }
+
+        c.tangential =
+            r.choice<TangentialLaw>("tangential", {{"none", TangentialLaw::None}, {"spring", TangentialLaw::Spring}})
+                .value_or(TangentialLaw::Spring);
+        if (c.tangential == TangentialLaw::None) {
+            for (const char* key : {"kt", "kt_ratio", "gamma_t"}) r.forbid(key, "only for tangential = \"spring\"");
+        }
+        c.kt = r.number("kt");
+        c.ktRatio = r.number("kt_ratio");
+        if (c.kt && c.ktRatio) r.fail("kt_ratio", "not together with kt (give one of them)");
+        if (c.kt && !(*c.kt > 0)) r.fail("kt", "must be > 0");
+        if (c.ktRatio && !(*c.ktRatio > 0 && *c.ktRatio <= 1)) r.fail("kt_ratio", "must satisfy 0 < kt_ratio <= 1");
+        c.gammaT = r.number("gamma_t").value_or(c.gammaT);
+        if (!(c.gammaT >= 0)) r.fail("gamma_t", "must be >= 0");
+        c.attraction = r.boolean("attraction").value_or(c.attraction);
+        c.impactVelocity = r.number("impact_velocity").value_or(c.impactVelocity);
+        if (!(c.impactVelocity > 0)) r.fail("impact_velocity", "must be > 0");
+    }
+
+    void readTdm(Scenario& s) {
+        const TableReader r = child("tdm");
+        r.allowOnly({"integrator", "dt", "steps_per_contact", "skin", "max_overlap", "sort_every"});
+        TdmDef& t = s.tdm;
+        t.pos = r.tablePos();
+        t.integrator = r.choice<IntegratorKind>("integrator",
+                                                {{"verlet", IntegratorKind::Verlet}, {"gear5", IntegratorKind::Gear5}})
+                           .value_or(IntegratorKind::Verlet);
+        if (const toml::node* n = r.table().get("dt")) {
+            if (const auto* str = n->as_string()) {
+                if (str->get() != "auto") r.fail("dt", "must be \"auto\" or a number > 0");
+            } else if (n->is_number()) {
+                t.dt = r.number("dt");
+                if (!(*t.dt > 0)) r.fail("dt", "must be > 0");
+            } else {
+                r.fail("dt", "expected a number or \"auto\"");
+            }
+        }
+        t.stepsPerContact = r.number("steps_per_contact").value_or(t.stepsPerContact);
+        if (!(t.stepsPerContact >= 5)) r.fail("steps_per_contact", "must be >= 5");
+        t.skin = r.number("skin");
+        if (t.skin && !(*t.skin > 0)) r.fail("skin", "must be > 0");
+        t.maxOverlap = r.number("max_overlap").value_or(t.maxOverlap);
+        if (!(t.maxOverlap > 0 && t.maxOverlap <= 1)) r.fail("max_overlap", "must satisfy 0 < max_overlap <= 1");
+        if (const auto every = r.integer("sort_every")) {
+            if (*every < 0) r.fail("sort_every", "must be >= 0");
+            if (*every > 2147483647) r.fail("sort_every", "too large");
+            t.sortEvery = int(*every);
+        }
+    }
+
+    void readWalls(Scenario& s) {
+        const toml::array* walls = root_.arrayOfTables("walls");
+        if (!walls) return;
+        for (std::size_t i = 0; i < walls->size(); ++i) {
+            const TableReader r(*walls->get(i)->as_table(), "walls[" + std::to_string(i + 1) + "]", file_);
+            r.allowOnly({"point", "normal", "material", "velocity"});
+            WallDef w;
+            w.pos = r.tablePos();
+            w.point = r.requiredVector("point", dim_);
+            w.normal = r.requiredVector("normal", dim_);
+            const double len =
+                std::sqrt(w.normal[0] * w.normal[0] + w.normal[1] * w.normal[1] + w.normal[2] * w.normal[2]);
+            if (!(len > 0)) r.fail("normal", "must be nonzero");
+            for (double& c : w.normal) c /= len;
+            w.material = materialIndex(r, "material");
+            w.velocity = r.vector("velocity", dim_).value_or(Vec3d{0, 0, 0});
+            s.walls.push_back(w);
+        }
+    }
+
+    void readInserts(Scenario& s) {
+        const toml::array* inserts = root_.arrayOfTables("insert");
+        if (!inserts) return;
+        for (std::size_t i = 0; i < inserts->size(); ++i) {
+            const TableReader r(*inserts->get(i)->as_table(), "insert[" + std::to_string(i + 1) + "]", file_);
+            s.inserts.push_back(readInsert(r));
+        }
+    }
+
+    InsertDef readInsert(const TableReader& r) const {
+        r.allowOnly({"arrangement", "count", "radius", "material", "region", "spacing", "velocity", "temperature",
+                     "frozen", "file", "format"});
+        InsertDef in;
+        in.pos = r.tablePos();
+        in.arrangement = r.choice<Arrangement>("arrangement", {{"random", Arrangement::Random},
+                                                               {"lattice", Arrangement::Lattice},
+                                                               {"file", Arrangement::File}})
+                             .value_or(Arrangement::Random);
+        in.material = materialIndex(r, "material");
+        in.frozen = r.boolean("frozen").value_or(false);
+
+        if (in.arrangement == Arrangement::File) {
+            const std::string why = "not used with arrangement = \"file\" (the file gives it per particle)";
+            for (const char* key : {"count", "radius", "region", "spacing", "velocity", "temperature"})
+                r.forbid(key, why);
+            const std::string name = r.requiredString("file");
+            if (name.empty()) r.fail("file", "must not be empty");
+            std::filesystem::path p(name);
+            if (p.is_relative()) p = dir_ / p;
+            std::error_code ec;
+            if (!std::filesystem::is_regular_file(p, ec)) r.fail("file", "file not found: " + p.string());
+            in.file = p.string();
+            in.format = r.choice<FileFormat>("format", {{"csv", FileFormat::Csv}, {"lammps", FileFormat::LammpsData}})
+                            .value_or(FileFormat::Csv);
+            return in;
+        }
+
+        const std::string why = "only for arrangement = \"file\"";
+        r.forbid("file", why);
+        r.forbid("format", why);
+
+        const auto count = r.integer("count");
+        if (!count) r.fail("count", "is required");
+        if (*count <= 0) r.fail("count", "must be > 0");
+        in.count = std::size_t(*count);
+
+        readRadius(r, in);
+        readRegion(r, in);
+
+        if (in.arrangement == Arrangement::Lattice) {
+            in.spacing = r.number("spacing");
+            if (in.spacing) {
+                if (!(*in.spacing > 0)) r.fail("spacing", "must be > 0");
+                if (*in.spacing < 2 * in.radiusMax)
+                    r.fail("spacing", "lattice overlaps: spacing " + formatNumber(*in.spacing) + " < 2 x radius " +
+                                          formatNumber(2 * in.radiusMax));
+            }
+        } else {
+            r.forbid("spacing", "only for arrangement = \"lattice\"");
+        }
+
+        in.velocity = r.vector("velocity", dim_).value_or(Vec3d{0, 0, 0});
+        in.temperature = r.number("temperature").value_or(0.0);
+        if (!(in.temperature >= 0)) r.fail("temperature", "must be >= 0");
+        return in;
+    }
+
+    void readRadius(const TableReader& r, InsertDef& in) const {
+        const toml::node* n = r.table().get("radius");
+        if (!n) r.fail("radius", "is required");
+        if (n->is_array()) {
+            const auto range = r.vector("radius", 2);  // "expected an array of 2 numbers" when malformed
+            in.radiusMin = (*range)[0];
+            in.radiusMax = (*range)[1];
+            if (!(in.radiusMin > 0 && in.radiusMin <= in.radiusMax)) r.fail("radius", "must satisfy 0 < min <= max");
+        } else {
+            if (!n->is_number()) r.fail("radius", "expected a number or an array [min, max] of 2 numbers");
+            in.radiusMin = in.radiusMax = *r.number("radius");
+            if (!(in.radiusMin > 0)) r.fail("radius", "must be > 0");
+        }
+    }
+
+    void readRegion(const TableReader& r, InsertDef& in) const {
+        in.regionLo = domain_.lo;
+        in.regionHi = domain_.hi;
+        if (const toml::table* t = r.subTable("region")) {
+            const TableReader g(*t, r.keyPath("region"), file_);
+            g.allowOnly({"lo", "hi"});
+            in.regionLo = g.requiredVector("lo", dim_);
+            in.regionHi = g.requiredVector("hi", dim_);
+            for (int k = 0; k < dim_; ++k) {
+                if (!(in.regionHi[k] > in.regionLo[k]))
+                    g.fail("hi", std::string("must be > lo on every axis (axis ") + kAxisName[k] + ")");
+                if (in.regionLo[k] < domain_.lo[k] || in.regionHi[k] > domain_.hi[k])
+                    r.fail("region", std::string("must lie inside the domain (axis ") + kAxisName[k] + ": [" +
+                                         formatNumber(in.regionLo[k]) + ", " + formatNumber(in.regionHi[k]) +
+                                         "] is not inside [" + formatNumber(domain_.lo[k]) + ", " +
+                                         formatNumber(domain_.hi[k]) + "])");
+            }
+        }
+        for (int k = 0; k < dim_; ++k)
+            if (in.regionHi[k] - in.regionLo[k] < 2 * in.radiusMax)
+                r.fail(r.has("region") ? "region" : "radius",
+                       std::string("the region is narrower than one particle diameter on axis ") + kAxisName[k]);
+    }
+
+    void readOutput(Scenario& s) {
+        const TableReader r = child("output");
+        r.allowOnly({"directory", "series_period", "snapshot_period"});
+        OutputDef& o = s.output;
+        o.pos = r.tablePos();
+        o.directory = r.string("directory").value_or(o.directory);
+        if (o.directory.empty()) r.fail("directory", "must not be empty");
+        o.seriesPeriod = r.number("series_period").value_or(o.seriesPeriod);
+        if (!(o.seriesPeriod >= 0)) r.fail("series_period", "must be >= 0");
+        o.snapshotPeriod = r.number("snapshot_period").value_or(o.snapshotPeriod);
+    }
+
+    TableReader root_;
+    std::string file_;
+    std::filesystem::path dir_;
+    int dim_ = 3;
+    DomainDef domain_;
+    const std::vector<MaterialDef>* materials_ = nullptr;
+};
+
+}  // namespace
+
+std::string fnv1a64Hex(std::string_view bytes) {
+    std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a 64 offset basis
+    for (unsigned char c : bytes) {
+        h ^= c;
+        h *= 0x100000001b3ull;  // FNV 64 prime
+    }
+    static const char* digits = "0123456789abcdef";
+    std::string out(16, '0');
+    for (int i = 15; i >= 0; --i, h >>= 4) out[std::size_t(i)] = digits[h & 0xf];
+    return out;
+}
+
+Scenario parseScenario(std::string_view text, const std::filesystem::path& file) {
+    const std::string name = file.string();
+    toml::table root;
+    try {
+        root = toml::parse(text, std::string_view(name));
+    } catch (const toml::parse_error& e) {
+        throw ScenarioError({name, int(e.source().begin.line)}, "",
+                            "TOML syntax error: " + std::string(e.description()));
+    }
+    Scenario s = Loader(root, name, file.parent_path()).load();
+    s.hash = fnv1a64Hex(text);
+    return s;
+}
+
+Scenario loadScenario(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw ScenarioError({file.string(), 0}, "", "cannot open the scenario file");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return parseScenario(text, file);
+}
+
+}  // namespace haet

@@ -1,0 +1,88 @@
+#include "world/build.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/rng.hpp"
+#include "scenario/insert.hpp"
+
+namespace haet {
+
+template <int D>
+std::vector<MaterialStats> materialStats(const Particles<D>& p, int nMaterials) {
+    std::vector<MaterialStats> st(nMaterials);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        MaterialStats& s = st[p.material[i]];
+        s.meanRadius += p.radius[i];
+        s.meanMass += p.mass[i];
+        s.minRadius = s.count ? std::min(s.minRadius, p.radius[i]) : p.radius[i];
+        s.minMass = s.count ? std::min(s.minMass, p.mass[i]) : p.mass[i];
+        ++s.count;
+    }
+    for (auto& s : st)
+        if (s.count) {
+            s.meanRadius /= s.count;
+            s.meanMass /= s.count;
+        }
+    return st;
+}
+
+template <int D>
+static Vec<D> toVec(const Vec3d& a) {
+    Vec<D> v;
+    for (int k = 0; k < D; ++k) v[k] = a[k];
+    return v;
+}
+
+template <int D>
+World<D> buildWorld(const Scenario& sc) {
+    World<D> w;
+    w.domain.lo = toVec<D>(sc.domain.lo);
+    w.domain.hi = toVec<D>(sc.domain.hi);
+    w.domain.gravity = toVec<D>(sc.domain.gravity);
+    for (int k = 0; k < D; ++k) w.domain.periodic[k] = sc.domain.periodic[k];
+    for (const WallDef& wd : sc.walls) {
+        Wall<D> wall;
+        wall.point = toVec<D>(wd.point);
+        wall.normal = toVec<D>(wd.normal);
+        wall.normal *= 1.0 / norm(wall.normal);
+        wall.velocity = toVec<D>(wd.velocity);
+        wall.material = wd.material;
+        w.walls.push_back(wall);
+    }
+    insertParticles<D>(sc, w.particles, Rng(sc.seed, RngStream::Insert));
+    w.contact = buildContactSetup(sc, materialStats(w.particles, static_cast<int>(sc.materials.size())));
+    return w;
+}
+
+template <int D>
+TdmSettings tdmSettings(const Scenario& sc, const World<D>& w, std::string* dtNote) {
+    TdmSettings s;
+    s.integrator = sc.tdm.integrator;
+    s.maxOverlap = sc.tdm.maxOverlap;
+    s.sortEvery = sc.tdm.sortEvery;
+    std::ostringstream note;
+    if (sc.tdm.dt) {
+        s.dt = *sc.tdm.dt;
+        note << "given; t_c/dt = " << w.contact.contactTime / s.dt;
+    } else {
+        s.dt = w.contact.contactTime / sc.tdm.stepsPerContact;
+        note << "auto: t_c / " << sc.tdm.stepsPerContact << " (" << w.contact.contactTimeNote << ")";
+    }
+    if (dtNote) *dtNote = note.str();
+    double dmax = 0;
+    for (double r : w.particles.radius) dmax = std::max(dmax, 2 * r);
+    // Default skin: a tenth of the largest diameter (LAMMPS granular inputs typically use 0.1 d).
+    s.skin = sc.tdm.skin ? *sc.tdm.skin : (dmax > 0 ? 0.1 * dmax : 1e-3);
+    return s;
+}
+
+template World<2> buildWorld<2>(const Scenario&);
+template World<3> buildWorld<3>(const Scenario&);
+template TdmSettings tdmSettings<2>(const Scenario&, const World<2>&, std::string*);
+template TdmSettings tdmSettings<3>(const Scenario&, const World<3>&, std::string*);
+template std::vector<MaterialStats> materialStats<2>(const Particles<2>&, int);
+template std::vector<MaterialStats> materialStats<3>(const Particles<3>&, int);
+
+}  // namespace haet
