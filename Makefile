@@ -25,7 +25,8 @@ validate: build
 	cd $(BUILD) && ctest -L validate --output-on-failure -j $(JOBS)
 
 demo: build
-	$(BUILD)/haet run examples/box3d_settle.toml --out runs/demo
+	$(BUILD)/haet run examples/box2d_settle.toml --out runs/demo
+	@echo "demo: outputs in runs/demo (final.png, series.csv, particles.pvd, run.json)"
 
 bench: build
 	bench/run_all.sh $(BUILD)

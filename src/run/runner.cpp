@@ -13,6 +13,7 @@
 #include "core/version.hpp"
 #include "io/atomic_file.hpp"
 #include "io/json.hpp"
+#include "io/png.hpp"
 #include "io/series.hpp"
 #include "io/vtk.hpp"
 #include "tdm/engine.hpp"
@@ -141,6 +142,30 @@ private:
     int count_ = 0;
 };
 
+/// A picture of a 2D state: disks coloured by speed (blue slow, red fast), walls as lines.
+void writePicture(const World<2>& w, const std::filesystem::path& path) {
+    PngScene scene;
+    scene.lo = {w.domain.lo[0], w.domain.lo[1]};
+    scene.hi = {w.domain.hi[0], w.domain.hi[1]};
+    scene.widthPx = 900;
+    const Particles<2>& p = w.particles;
+    double vmax = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) vmax = std::max(vmax, norm(p.v[i]));
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const double s = vmax > 0 ? norm(p.v[i]) / vmax : 0;
+        const auto r = static_cast<std::uint32_t>(60 + 195 * s), b = static_cast<std::uint32_t>(255 - 195 * s);
+        scene.disks.push_back({p.x[i][0], p.x[i][1], p.radius[i], p.frozen(i) ? 0x606060u : (r << 16) | (90u << 8) | b});
+    }
+    for (const Wall<2>& wl : w.walls) {
+        const Vec<2> pt = wl.pointAt(w.time);
+        const Vec<2> t{{-wl.normal[1], wl.normal[0]}};
+        const double L = norm(w.domain.length());
+        scene.walls.push_back({pt[0] - t[0] * L, pt[1] - t[1] * L, pt[0] + t[0] * L, pt[1] + t[1] * L});
+    }
+    scene.caption = fmt::format("t = {:.4g} s, {} particles (colour: speed, max {:.3g} m/s)", w.time, p.size(), vmax);
+    writePng(path, scene);
+}
+
 /// One-line progress on a terminal: simulated time, steps/s, contacts, ETA.
 class Progress {
 public:
@@ -257,6 +282,7 @@ RunStatus runTdm(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
     progress.finish();
     series.flush();
     writeRunJson(statusText);
+    if constexpr (D == 2) writePicture(world, dir / "final.png");
     if (!opt.quiet) {
         const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
         log << fmt::format("{}: {} particles, {} steps of {:.4g} s, simulated {:.4g} s in {:.2f} s wall time "

@@ -112,6 +112,7 @@ struct InsertDef {
     bool frozen = false;
     std::string file;                  ///< arrangement = File: path (resolved against the scenario dir)
     FileFormat format = FileFormat::Csv;
+    std::vector<int> frozenTypes;      ///< LAMMPS data files: atom types (1-based) whose particles are frozen
     SourcePos pos;
 };
 

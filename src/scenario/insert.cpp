@@ -347,7 +347,9 @@ std::vector<NewParticle<D>> insertFromFile(const Scenario& s, std::size_t k) {
         } else {
             p.density = s.materials[std::size_t(mat)].density;
         }
-        p.flags = (in.frozen || fp.frozen) ? kFrozen : 0;
+        const bool frozenType =
+            std::find(in.frozenTypes.begin(), in.frozenTypes.end(), fp.type) != in.frozenTypes.end();
+        p.flags = (in.frozen || fp.frozen || frozenType) ? kFrozen : 0;
         if (pf.boxLo && pf.boxHi)
             for (int a = 0; a < D; ++a)
                 p.image[a] = fp.image[std::size_t(a)] * ((*pf.boxHi)[std::size_t(a)] - (*pf.boxLo)[std::size_t(a)]);

@@ -145,6 +145,22 @@ public:
         return out;
     }
 
+    /// An array of integers, each at least `min`.
+    std::optional<std::vector<int>> integers(std::string_view key, int min) const {
+        const toml::node* n = table_.get(key);
+        if (!n) return std::nullopt;
+        const std::string expected = "expected an array of integers >= " + std::to_string(min);
+        const toml::array* a = n->as_array();
+        if (!a) fail(key, expected);
+        std::vector<int> out;
+        for (std::size_t k = 0; k < a->size(); ++k) {
+            const auto* v = a->get(k)->as_integer();
+            if (!v || v->get() < min || v->get() > 1000000) fail(key, expected);
+            out.push_back(static_cast<int>(v->get()));
+        }
+        return out;
+    }
+
     /// A string that must be one of `options`; returns the matching value.
     template <class E>
     std::optional<E> choice(std::string_view key, std::initializer_list<std::pair<std::string_view, E>> options) const {
@@ -417,7 +433,7 @@ private:
 
     InsertDef readInsert(const TableReader& r) const {
         r.allowOnly({"arrangement", "count", "radius", "material", "region", "spacing", "velocity", "temperature",
-                     "frozen", "file", "format"});
+                     "frozen", "file", "format", "frozen_types"});
         InsertDef in;
         in.pos = r.tablePos();
         in.arrangement = r.choice<Arrangement>("arrangement", {{"random", Arrangement::Random},
@@ -426,6 +442,8 @@ private:
                              .value_or(Arrangement::Random);
         in.material = materialIndex(r, "material");
         in.frozen = r.boolean("frozen").value_or(false);
+        if (r.has("frozen_types") && r.string("arrangement").value_or("random") != "file")
+            r.fail("frozen_types", "only for arrangement = \"file\" with format = \"lammps\"");
 
         if (in.arrangement == Arrangement::File) {
             const std::string why = "not used with arrangement = \"file\" (the file gives it per particle)";
@@ -440,6 +458,9 @@ private:
             in.file = p.string();
             in.format = r.choice<FileFormat>("format", {{"csv", FileFormat::Csv}, {"lammps", FileFormat::LammpsData}})
                             .value_or(FileFormat::Csv);
+            if (in.format != FileFormat::LammpsData)
+                r.forbid("frozen_types", "only for format = \"lammps\" (a CSV file has a frozen column)");
+            in.frozenTypes = r.integers("frozen_types", 1).value_or(std::vector<int>{});
             return in;
         }
 
