@@ -29,19 +29,29 @@ void VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
     const double h2 = 0.5 * dt * dt;
     m.v.resize(n);
     m.w.resize(n);
+    // Raw pointers: stores through them cannot alias the vectors' own data pointers, so the loop stays tight.
+    Vec<D>* __restrict x = p.x.data();
+    Vec<D>* __restrict v = p.v.data();
+    Ang<D>* __restrict ang = p.angle.data();
+    Ang<D>* __restrict w = p.w.data();
+    Vec<D>* __restrict mv = m.v.data();
+    Ang<D>* __restrict mw = m.w.data();
+    const Vec<D>* __restrict acc = acc_.data();
+    const Ang<D>* __restrict alpha = alpha_.data();
+    const std::uint8_t* __restrict flags = p.flags.data();
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
-        if (p.flags[i] & kFrozen) {
-            m.v[i] = p.v[i];
-            m.w[i] = p.w[i];
+        if (flags[i] & kFrozen) {
+            mv[i] = v[i];
+            mw[i] = w[i];
             continue;
         }
-        m.v[i] = p.v[i] + acc_[i] * (0.5 * dt);  // v(t + dt/2)
-        m.w[i] = p.w[i] + alpha_[i] * (0.5 * dt);
-        p.x[i] += p.v[i] * dt + acc_[i] * h2;
-        p.v[i] += acc_[i] * dt;
-        p.angle[i] += p.w[i] * dt + alpha_[i] * h2;
-        p.w[i] += alpha_[i] * dt;
+        mv[i] = v[i] + acc[i] * (0.5 * dt);  // v(t + dt/2)
+        mw[i] = w[i] + alpha[i] * (0.5 * dt);
+        x[i] += v[i] * dt + acc[i] * h2;
+        v[i] += acc[i] * dt;
+        ang[i] += w[i] * dt + alpha[i] * h2;
+        w[i] += alpha[i] * dt;
     }
 }
 
@@ -49,15 +59,24 @@ template <int D>
 void VelocityVerlet<D>::correct(Particles<D>& p, double dt) {
     const std::size_t n = p.size();
     const double h = 0.5 * dt;
+    Vec<D>* __restrict v = p.v.data();
+    Ang<D>* __restrict w = p.w.data();
+    Vec<D>* __restrict acc = acc_.data();
+    Ang<D>* __restrict alpha = alpha_.data();
+    const Vec<D>* __restrict f = p.f.data();
+    const Ang<D>* __restrict tq = p.torque.data();
+    const double* __restrict im = p.invMass.data();
+    const double* __restrict ii = p.invInertia.data();
+    const std::uint8_t* __restrict flags = p.flags.data();
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
-        if (p.flags[i] & kFrozen) continue;
-        const Vec<D> a = p.f[i] * p.invMass[i];
-        const Ang<D> al = p.torque[i] * p.invInertia[i];
-        p.v[i] += (a - acc_[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
-        p.w[i] += (al - alpha_[i]) * h;
-        acc_[i] = a;
-        alpha_[i] = al;
+        if (flags[i] & kFrozen) continue;
+        const Vec<D> a = f[i] * im[i];
+        const Ang<D> al = tq[i] * ii[i];
+        v[i] += (a - acc[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
+        w[i] += (al - alpha[i]) * h;
+        acc[i] = a;
+        alpha[i] = al;
     }
 }
 
