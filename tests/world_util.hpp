@@ -2,6 +2,7 @@
 // Small worlds built directly in code for unit tests (no scenario file).
 #include "contact/setup.hpp"
 #include "scenario/definition.hpp"
+#include "world/build.hpp"
 #include "world/world.hpp"
 
 namespace haet::testing {
@@ -26,21 +27,7 @@ inline Scenario linearScenario(int dim, double e, double tc, double mu = 0.0,
 
 template <int D>
 std::vector<MaterialStats> statsOf(const Particles<D>& p, int nMaterials) {
-    std::vector<MaterialStats> st(nMaterials);
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        MaterialStats& s = st[p.material[i]];
-        s.meanRadius += p.radius[i];
-        s.meanMass += p.mass[i];
-        s.minRadius = s.count ? std::min(s.minRadius, p.radius[i]) : p.radius[i];
-        s.minMass = s.count ? std::min(s.minMass, p.mass[i]) : p.mass[i];
-        ++s.count;
-    }
-    for (auto& s : st)
-        if (s.count) {
-            s.meanRadius /= s.count;
-            s.meanMass /= s.count;
-        }
-    return st;
+    return materialStats(p, nMaterials);
 }
 
 template <int D>

@@ -1,4 +1,5 @@
 #include "scenario/insert.hpp"
+#include "scenario/text.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -17,14 +18,6 @@ namespace {
 
 std::string insertKey(std::size_t k) { return "insert[" + std::to_string(k + 1) + "]"; }
 
-std::string inQuotes(std::string_view s) { return "\"" + std::string(s) + "\""; }
-
-std::string formatNumber(double v) {
-    std::ostringstream os;
-    os.precision(6);
-    os << v;
-    return os.str();
-}
 
 std::string_view trim(std::string_view s) {
     const auto first = s.find_first_not_of(" \t\r\n");

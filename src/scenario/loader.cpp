@@ -1,4 +1,5 @@
 #include "scenario/loader.hpp"
+#include "scenario/text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,14 +19,6 @@ namespace {
 
 const char* const kAxisName[3] = {"x", "y", "z"};
 
-std::string inQuotes(std::string_view s) { return "\"" + std::string(s) + "\""; }
-
-std::string formatNumber(double v) {
-    std::ostringstream os;
-    os.precision(6);
-    os << v;
-    return os.str();
-}
 
 /// Reads the values of one TOML table and knows the dotted key path of each, so that every error names the key
 /// and the line it came from (the value's line, or the table's when the key is missing).
