@@ -84,7 +84,7 @@ struct NoTangential {
 struct SpringTangential {
     static constexpr bool kHasHistory = true;
     template <int D>
-    static Vec<D> eval(const PairCoeffs& c, double fn, double kNormal, double meff, const Vec<D>& n,
+    [[gnu::always_inline]] static inline Vec<D> eval(const PairCoeffs& c, double fn, double kNormal, double meff, const Vec<D>& n,
                        const Vec<D>& gt, const Vec<D>& gStep, Vec<D>& xi, double dt) {
         // The contact plane turns with the pair: project xi onto it and keep its length (Luding 2008).
         const double len2 = norm2(xi);
