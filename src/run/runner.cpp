@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <fmt/format.h>
 #include <omp.h>
 #include <ostream>
@@ -30,29 +31,86 @@ std::size_t peakRssBytes() {
     return static_cast<std::size_t>(ru.ru_maxrss) * 1024;
 }
 
-/// Global measurements of a state (energies in J; pressure in Pa, or N/m in 2D).
+/// Energies of a state common to every engine [J].
 template <int D>
-struct Sample {
-    double kinetic = 0, rotational = 0, potential = 0, elastic = 0;
-    double pressure = std::nan("");
+struct Energies {
+    double kinetic = 0, rotational = 0, potential = 0;
+    double mv2 = 0;  ///< sum m v^2 [J], for the kinetic pressure
 };
 
 template <int D>
-Sample<D> measure(const World<D>& w, const TdmEngine<D>& eng) {
+Energies<D> energies(const World<D>& w) {
     const Particles<D>& p = w.particles;
-    Sample<D> s;
-    double mv2 = 0;
+    Energies<D> s;
     for (std::size_t i = 0; i < p.size(); ++i) {
         const double m = p.mass[i];
         const double v2 = norm2(p.v[i]);
         s.kinetic += 0.5 * m * v2;
-        mv2 += m * v2;
+        s.mv2 += m * v2;
         s.rotational += 0.5 * p.inertia(i) * norm2(p.w[i]);
         s.potential -= m * dot(w.domain.gravity, p.x[i] + p.image[i]);
     }
-    s.elastic = eng.contactEnergy();
-    if (w.domain.fullyPeriodic()) s.pressure = (mv2 + eng.pairVirial()) / (D * w.domain.volume());
     return s;
+}
+
+/// What the run loop needs from an engine. Engine-specific measurements are extra series columns.
+template <int D>
+class Driver {
+public:
+    virtual ~Driver() = default;
+    virtual const char* method() const = 0;
+    virtual void advanceTo(double t) = 0;
+    /// Time resolution of the engine: the loop treats times closer than this as equal [s].
+    virtual double timeTolerance() const = 0;
+    virtual std::uint64_t steps() const = 0;          ///< time steps taken (0 for a pure event-driven run)
+    virtual std::size_t contacts() const = 0;         ///< enduring contacts now
+    virtual double maxOverlapRatio() const = 0;
+    virtual double elasticEnergy() const = 0;         ///< energy stored in contacts [J]
+    /// Sum of r_ij . F_ij (soft contacts) plus collision virial / window (hard collisions) [J].
+    virtual double virial(double window) = 0;
+    virtual std::vector<std::string> extraColumns() const = 0;
+    virtual std::vector<std::optional<double>> extraRow() const = 0;
+    virtual void describe(JsonObject& j) const = 0;   ///< engine facts for run.json
+};
+
+template <int D>
+class TdmDriver final : public Driver<D> {
+public:
+    TdmDriver(World<D>& w, const TdmSettings& s, std::string dtNote) : eng_(w, s), note_(std::move(dtNote)) {}
+    const char* method() const override { return "tdm"; }
+    void advanceTo(double t) override { eng_.advanceTo(t); }
+    double timeTolerance() const override { return 0.5 * eng_.settings().dt; }
+    std::uint64_t steps() const override { return eng_.steps(); }
+    std::size_t contacts() const override { return eng_.forceStats().contacts; }
+    double maxOverlapRatio() const override { return eng_.forceStats().maxOverlapRatio; }
+    double elasticEnergy() const override { return eng_.contactEnergy(); }
+    double virial(double) override { return eng_.pairVirial(); }
+    std::vector<std::string> extraColumns() const override { return {"rebuilds"}; }
+    std::vector<std::optional<double>> extraRow() const override { return {double(eng_.rebuilds())}; }
+    void describe(JsonObject& j) const override {
+        j.add("dt", eng_.settings().dt);
+        j.add("dt_rule", note_);
+        j.add("neighbor_rebuilds", eng_.rebuilds());
+    }
+    const TdmEngine<D>& engine() const { return eng_; }
+
+private:
+    TdmEngine<D> eng_;
+    std::string note_;
+};
+
+template <int D>
+std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
+    switch (sc.method) {
+        case Method::Tdm: {
+            std::string note;
+            const TdmSettings ts = tdmSettings<D>(sc, world, &note);
+            return std::make_unique<TdmDriver<D>>(world, ts, note);
+        }
+        case Method::Edm:
+        case Method::Haet: break;
+    }
+    throw ScenarioError({sc.path, 0}, "method", "only \"tdm\" is available in this version");
 }
 
 template <int D>
@@ -195,31 +253,37 @@ private:
 };
 
 template <int D>
-RunStatus runTdm(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
+RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
     const auto t0 = Clock::now();
     std::filesystem::path dir = opt.outDir.empty() ? std::filesystem::path(sc.output.directory) : opt.outDir;
     std::filesystem::create_directories(dir);
 
     World<D> world = buildWorld<D>(sc);
-    std::string dtNote;
-    const TdmSettings ts = tdmSettings<D>(sc, world, &dtNote);
-    TdmEngine<D> eng(world, ts);
+    std::unique_ptr<Driver<D>> eng = makeDriver<D>(sc, world);
 
     const double seriesPeriod = sc.output.seriesPeriod > 0 ? sc.output.seriesPeriod : sc.duration / 100;
     const double snapPeriod = sc.output.snapshotPeriod == 0 ? sc.duration / 20 : sc.output.snapshotPeriod;
-    SeriesWriter series(dir / "series.csv",
-                        {"time", "step", "kinetic_energy", "rotational_energy", "potential_energy",
-                         "elastic_energy", "total_energy", "n_particles", "n_contacts", "max_overlap_ratio",
-                         "pressure", "rebuilds"});
+    std::vector<std::string> columns = {"time", "step", "kinetic_energy", "rotational_energy", "potential_energy",
+                                        "elastic_energy", "total_energy", "n_particles", "n_contacts",
+                                        "max_overlap_ratio", "pressure"};
+    for (auto& c : eng->extraColumns()) columns.push_back(c);
+    SeriesWriter series(dir / "series.csv", columns);
     SnapshotWriter<D> snaps(dir);
+    double lastRowTime = world.time;
     auto writeRow = [&]() {
-        const Sample<D> s = measure(world, eng);
-        std::optional<double> pr;
-        if (!std::isnan(s.pressure)) pr = s.pressure;
-        series.row({world.time, double(eng.steps()), s.kinetic, s.rotational, s.potential, s.elastic,
-                    s.kinetic + s.rotational + s.potential + s.elastic, double(world.particles.size()),
-                    double(eng.forceStats().contacts), eng.forceStats().maxOverlapRatio, pr,
-                    double(eng.rebuilds())});
+        const Energies<D> e = energies(world);
+        const double elastic = eng->elasticEnergy();
+        const double window = world.time - lastRowTime;
+        lastRowTime = world.time;
+        std::optional<double> pressure;
+        const double vir = eng->virial(window);
+        if (world.domain.fullyPeriodic()) pressure = (e.mv2 + vir) / (D * world.domain.volume());
+        std::vector<std::optional<double>> row = {
+            world.time, double(eng->steps()), e.kinetic, e.rotational, e.potential, elastic,
+            e.kinetic + e.rotational + e.potential + elastic, double(world.particles.size()),
+            double(eng->contacts()), eng->maxOverlapRatio(), pressure};
+        for (auto& v : eng->extraRow()) row.push_back(v);
+        series.row(row);
     };
 
     auto writeRunJson = [&](const std::string& status) {
@@ -229,19 +293,17 @@ RunStatus runTdm(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
         j.add("scenario", sc.path);
         j.add("scenario_name", sc.name);
         j.add("scenario_hash", sc.hash);
-        j.add("method", "tdm");
+        j.add("method", eng->method());
         j.add("dimension", static_cast<std::int64_t>(D));
         j.add("status", status);
         j.add("n_particles", world.particles.size());
-        j.add("dt", ts.dt);
-        j.add("dt_rule", dtNote);
         j.add("contact_time", world.contact.contactTime);
         j.add("simulated_time", world.time);
-        j.add("steps", eng.steps());
-        j.add("neighbor_rebuilds", eng.rebuilds());
+        j.add("steps", eng->steps());
+        eng->describe(j);
         j.add("wall_time", wall);
-        j.add("particle_steps_per_second", wall > 0 ? double(eng.steps()) * world.particles.size() / wall : 0.0);
-        j.add("threads", omp_get_max_threads());
+        j.add("particle_steps_per_second", wall > 0 ? double(eng->steps()) * world.particles.size() / wall : 0.0);
+        j.add("threads", static_cast<std::int64_t>(omp_get_max_threads()));
         j.add("peak_rss_bytes", peakRssBytes());
         writeFileAtomic(dir / "run.json", j.dump() + "\n");
     };
@@ -249,7 +311,9 @@ RunStatus runTdm(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
     const bool tty = !opt.quiet && isatty(STDERR_FILENO);
     Progress progress(tty, sc.duration);
     double nextSeries = 0, nextSnap = 0;
-    const double eps = 0.5 * ts.dt;
+    const double eps = eng->timeTolerance();
+    // Progress updates at least every 1/500 of the run (and never less than one step), so the line stays live.
+    const double chunk = std::max(sc.duration / 500, 2 * eps);
     RunStatus status = RunStatus::Completed;
     std::string statusText = "completed";
     try {
@@ -266,10 +330,9 @@ RunStatus runTdm(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
             if (world.time + eps >= sc.duration) break;
             double target = std::min(sc.duration, nextSeries);
             if (snapPeriod > 0) target = std::min(target, nextSnap);
-            // advance in chunks so the progress line stays live
             while (world.time + eps < target) {
-                eng.advanceTo(std::min(target, world.time + 200 * ts.dt));
-                progress.update(world.time, eng.steps(), eng.forceStats().contacts);
+                eng->advanceTo(std::min(target, world.time + chunk));
+                progress.update(world.time, eng->steps(), eng->contacts());
             }
         }
     } catch (const SimulationError& e) {
@@ -278,17 +341,15 @@ RunStatus runTdm(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
         status = RunStatus::BlewUp;
         statusText = std::string("failed: ") + e.what();
     }
-    progress.update(world.time, eng.steps(), eng.forceStats().contacts, true);
+    progress.update(world.time, eng->steps(), eng->contacts(), true);
     progress.finish();
     series.flush();
     writeRunJson(statusText);
     if constexpr (D == 2) writePicture(world, dir / "final.png");
     if (!opt.quiet) {
         const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-        log << fmt::format("{}: {} particles, {} steps of {:.4g} s, simulated {:.4g} s in {:.2f} s wall time "
-                           "({:.3g} particle-steps/s); outputs in {}\n",
-                           sc.name, world.particles.size(), eng.steps(), ts.dt, world.time, wall,
-                           wall > 0 ? eng.steps() * double(world.particles.size()) / wall : 0.0, dir.string());
+        log << fmt::format("{} ({}): {} particles, simulated {:.4g} s in {:.2f} s wall time; outputs in {}\n",
+                           sc.name, eng->method(), world.particles.size(), world.time, wall, dir.string());
     }
     return status;
 }
@@ -331,9 +392,7 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
 
 RunStatus runScenario(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
     if (opt.threads > 0) omp_set_num_threads(opt.threads);
-    if (sc.method != Method::Tdm)
-        throw ScenarioError({sc.path, 0}, "method", "only \"tdm\" is available in this version");
-    return sc.dimension == 2 ? runTdm<2>(sc, opt, log) : runTdm<3>(sc, opt, log);
+    return sc.dimension == 2 ? runWorld<2>(sc, opt, log) : runWorld<3>(sc, opt, log);
 }
 
 void describeScenario(const Scenario& sc, std::ostream& out) {

@@ -92,6 +92,30 @@ struct TdmDef {
     SourcePos pos;
 };
 
+enum class EdmTangential { Walton, Constant };
+
+/// Event-driven engine (method = "edm", and the dilute zones of "haet").
+struct EdmDef {
+    /// Tangential restitution: Walton's rule with (e, mu, beta0) of the materials, or beta = beta0 always.
+    EdmTangential tangential = EdmTangential::Walton;
+    bool tcModel = true;              ///< inelastic-collapse protection (TC model, PHYSICS.md D.7)
+    std::optional<double> tcTime;     ///< TC time [s]; default: the soft contact duration t_c
+    std::optional<double> cellSize;   ///< event grid cell edge [m]; default: the largest diameter
+    SourcePos pos;
+};
+
+/// The hybrid (method = "haet"), PHYSICS.md A: TDM where the local volume fraction is high, EDM where low.
+struct HaetDef {
+    std::optional<double> zoneSize;   ///< zone cell edge [m]; default 4 x the largest diameter
+    std::optional<double> phiOn;      ///< a zone turns dense above this volume (area) fraction [-]
+    std::optional<double> phiOff;     ///< and dilute again below this one [-]; phi_off < phi_on
+    int relabelEvery = 10;            ///< zone re-labelling period [TDM steps]
+    int buffer = 1;                   ///< zones around a dense zone whose particles are TDM too [cells]
+    int diluteSteps = 20;             ///< a TDM particle returns to EDM after its zone is dilute this long [steps]
+    std::optional<double> dtMin;      ///< modified EDM: minimum time between collisions [s]; default t_c
+    SourcePos pos;
+};
+
 struct WallDef {
     Vec3d point{0, 0, 0};    ///< a point on the plane [m]
     Vec3d normal{0, 0, 1};   ///< unit normal pointing into the domain (normalised by the loader)
@@ -134,6 +158,8 @@ struct Scenario {
     std::vector<MaterialDef> materials;
     ContactDef contact;
     TdmDef tdm;
+    EdmDef edm;
+    HaetDef haet;
     std::vector<WallDef> walls;
     std::vector<InsertDef> inserts;
     OutputDef output;

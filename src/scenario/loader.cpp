@@ -207,7 +207,7 @@ public:
 
     Scenario load() {
         root_.allowOnly({"name", "dimension", "method", "duration", "seed", "domain", "materials", "contact", "tdm",
-                         "walls", "insert", "output"});
+                         "edm", "haet", "walls", "insert", "output"});
         Scenario s;
         s.path = file_;
         readTop(s);
@@ -215,6 +215,8 @@ public:
         readMaterials(s);
         readContact(s);
         readTdm(s);
+        readEdm(s);
+        readHaet(s);
         readWalls(s);
         readInserts(s);
         readOutput(s);
@@ -393,6 +395,48 @@ private:
             if (*every > 2147483647) r.fail("sort_every", "too large");
             t.sortEvery = int(*every);
         }
+    }
+
+    void readEdm(Scenario& s) {
+        const TableReader r = child("edm");
+        r.allowOnly({"tangential", "tc_model", "tc_time", "cell_size"});
+        EdmDef& e = s.edm;
+        e.pos = r.tablePos();
+        e.tangential = r.choice<EdmTangential>("tangential", {{"walton", EdmTangential::Walton},
+                                                              {"constant", EdmTangential::Constant}})
+                           .value_or(EdmTangential::Walton);
+        e.tcModel = r.boolean("tc_model").value_or(true);
+        e.tcTime = r.number("tc_time");
+        if (e.tcTime && !(*e.tcTime > 0)) r.fail("tc_time", "must be > 0");
+        e.cellSize = r.number("cell_size");
+        if (e.cellSize && !(*e.cellSize > 0)) r.fail("cell_size", "must be > 0");
+    }
+
+    void readHaet(Scenario& s) {
+        const TableReader r = child("haet");
+        r.allowOnly({"zone_size", "phi_on", "phi_off", "relabel_every", "buffer", "dilute_steps", "dt_min"});
+        HaetDef& h = s.haet;
+        h.pos = r.tablePos();
+        h.zoneSize = r.number("zone_size");
+        if (h.zoneSize && !(*h.zoneSize > 0)) r.fail("zone_size", "must be > 0");
+        h.phiOn = r.number("phi_on");
+        if (h.phiOn && !(*h.phiOn > 0 && *h.phiOn < 1)) r.fail("phi_on", "must satisfy 0 < phi_on < 1");
+        h.phiOff = r.number("phi_off");
+        if (h.phiOff && !(*h.phiOff > 0 && *h.phiOff < 1)) r.fail("phi_off", "must satisfy 0 < phi_off < 1");
+        const double on = h.phiOn.value_or(s.dimension == 2 ? 0.45 : 0.30);
+        const double off = h.phiOff.value_or(s.dimension == 2 ? 0.40 : 0.25);
+        if (!(off < on)) r.fail(h.phiOff ? "phi_off" : "phi_on", "phi_off must be smaller than phi_on (hysteresis)");
+        auto count = [&](const char* key, int& out, int min) {
+            if (const auto v = r.integer(key)) {
+                if (*v < min || *v > 1000000000) r.fail(key, "must be an integer >= " + std::to_string(min));
+                out = int(*v);
+            }
+        };
+        count("relabel_every", h.relabelEvery, 1);
+        count("buffer", h.buffer, 0);
+        count("dilute_steps", h.diluteSteps, 0);
+        h.dtMin = r.number("dt_min");
+        if (h.dtMin && !(*h.dtMin > 0)) r.fail("dt_min", "must be > 0");
     }
 
     void readWalls(Scenario& s) {
