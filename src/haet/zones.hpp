@@ -1,0 +1,61 @@
+#pragma once
+// Zone labels of the hybrid (PHYSICS.md A.2): a uniform grid over the box; each zone is dense (time-driven) or
+// dilute (event-driven) from its smoothed local volume fraction, with hysteresis, sticky zones (enduring
+// contacts, particles resting on walls) and a buffer of dense-adjacent zones.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/particles.hpp"
+#include "geometry/domain.hpp"
+
+namespace haet {
+
+struct ZoneSettings {
+    double size = 0;     ///< zone edge [m] (rounded so that an integer number of zones spans each axis)
+    double phiOn = 0.3;  ///< dilute -> dense above this smoothed fraction [-]
+    double phiOff = 0.25;  ///< dense -> dilute below this one [-]
+    int buffer = 1;      ///< zones around a dense zone whose particles are time-driven too
+};
+
+template <int D>
+class ZoneGrid {
+public:
+    ZoneGrid(const Domain<D>& dom, const ZoneSettings& s);
+
+    int count() const { return total_; }
+    const std::array<int, D>& dims() const { return n_; }
+    int zoneOf(const Vec<D>& x) const;
+
+    /// Recomputes the volume fraction of every zone from the particles (centres in the zone), smooths it over
+    /// the zone and its neighbours, and updates the labels with hysteresis. sticky[z] != 0 keeps zone z dense.
+    void relabel(const Particles<D>& p, const std::vector<std::uint8_t>& sticky);
+
+    /// Dense zone (before the buffer).
+    bool dense(int z) const { return dense_[z]; }
+    /// A particle in zone z is time-driven: z or a zone within `buffer` of it is dense.
+    bool timeDriven(int z) const { return tdm_[z]; }
+    double fraction(int z) const { return phi_[z]; }          ///< raw fraction of zone z
+    double smoothed(int z) const { return phiSmooth_[z]; }    ///< smoothed fraction of zone z
+    std::size_t changedLast() const { return changed_; }      ///< zones whose timeDriven label changed in the last relabel
+    double zoneVolume() const { return cellVolume_; }
+    Vec<D> zoneWidth() const { return width_; }
+    Vec<D> origin() const { return lo_; }
+
+private:
+    /// Neighbour zones within `radius` (periodic axes wrap; others are clipped), without duplicates.
+    template <class F>
+    void forNeighbours(int z, int radius, F&& f) const;
+
+    ZoneSettings s_;
+    std::array<int, D> n_{};
+    std::array<bool, D> periodic_{};
+    Vec<D> lo_, width_;
+    int total_ = 1;
+    double cellVolume_ = 1;
+    std::vector<double> phi_, phiSmooth_;
+    std::vector<std::uint8_t> dense_, tdm_;
+    std::size_t changed_ = 0;
+};
+
+}  // namespace haet
