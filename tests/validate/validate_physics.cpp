@@ -1,0 +1,163 @@
+// Long physics validations of the time-driven engine (`make validate`, label "validate"): the 10^5-step versions
+// of the conservation and settling checks whose short versions are in tests/test_physics.cpp. Same scenes
+// (tests/data/), same criteria.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "scenario/loader.hpp"
+#include "tdm/engine.hpp"
+#include "world/build.hpp"
+
+namespace haet {
+namespace {
+
+Scenario dataScenario(const std::string& name) {
+    return loadScenario(std::filesystem::path(HAET_SOURCE_DIR) / "tests" / "data" / name);
+}
+
+/// A measured value in the test's XML report (--gtest_output=xml), to follow margins over time.
+void record(const std::string& key, double value) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", value);
+    ::testing::Test::RecordProperty(key, buf);
+}
+
+/// Translational + rotational kinetic energy [J].
+template <int D>
+double kineticEnergy(const Particles<D>& p) {
+    double e = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+        e += 0.5 * p.mass[i] * norm2(p.v[i]) + 0.5 * p.inertia(i) * norm2(p.w[i]);
+    return e;
+}
+
+template <int D>
+Vec<D> momentum(const Particles<D>& p) {
+    Vec<D> s = Vec<D>::zero();
+    for (std::size_t i = 0; i < p.size(); ++i) s += p.v[i] * p.mass[i];
+    return s;
+}
+
+template <int D>
+double momentumScale(const Particles<D>& p) {
+    double s = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) s += p.mass[i] * norm(p.v[i]);
+    return s;
+}
+
+// ---- elastic gas, 10^5 Gear5 steps: total energy (kinetic + contact) within 1e-4, momentum to round-off ----
+
+template <int D>
+void elasticGas(const char* file) {
+    const Scenario sc = dataScenario(file);
+    ASSERT_EQ(sc.tdm.integrator, IntegratorKind::Gear5);
+    World<D> w = buildWorld<D>(sc);
+    TdmEngine<D> eng(w, tdmSettings<D>(sc, w));
+    const double e0 = kineticEnergy(w.particles) + eng.contactEnergy();
+    const Vec<D> p0 = momentum(w.particles);
+    double drift = 0, dp = 0, contactSteps = 0;
+    for (int k = 1; k <= 100000; ++k) {
+        eng.step();
+        contactSteps += eng.forceStats().contacts;
+        if (k % 100 == 0) {
+            drift = std::max(drift, std::abs(kineticEnergy(w.particles) + eng.contactEnergy() - e0) / e0);
+            dp = std::max(dp, norm(momentum(w.particles) - p0) / momentumScale(w.particles));
+        }
+    }
+    const double collisionsPerParticle = contactSteps / sc.tdm.stepsPerContact / w.particles.size();
+    record("energy_drift", drift);
+    record("collisions_per_particle", collisionsPerParticle);
+    EXPECT_GT(collisionsPerParticle, 10.0) << "too few collisions for a meaningful test";
+    EXPECT_LT(drift, 1e-4);
+    EXPECT_LT(dp, 1e-12);
+}
+
+TEST(ValidateElasticGas, Gear5Conserves3D) { elasticGas<3>("gas3d.toml"); }
+TEST(ValidateElasticGas, Gear5Conserves2D) { elasticGas<2>("gas2d.toml"); }
+
+// ---- settling of ~500 spheres / disks in a closed box ----
+
+/// Volume (area) fraction covered by particles inside [lo, hi], sampled on a grid of spacing about h.
+template <int D>
+double coveredFraction(const Particles<D>& p, const Vec<D>& lo, const Vec<D>& hi, double h) {
+    std::array<long, 3> n{1, 1, 1};
+    for (int k = 0; k < D; ++k) n[k] = std::max(1L, static_cast<long>((hi[k] - lo[k]) / h));
+    std::vector<std::uint8_t> covered(n[0] * n[1] * n[2], 0);
+    auto centre = [&](int k, long c) { return lo[k] + (c + 0.5) * (hi[k] - lo[k]) / n[k]; };
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        std::array<long, 3> c0{0, 0, 0}, c1{0, 0, 0};
+        bool outside = false;
+        for (int k = 0; k < D; ++k) {
+            const double cell = (hi[k] - lo[k]) / n[k];
+            c0[k] = std::max(0L, static_cast<long>(std::floor((p.x[i][k] - p.radius[i] - lo[k]) / cell)));
+            c1[k] = std::min(n[k] - 1, static_cast<long>(std::floor((p.x[i][k] + p.radius[i] - lo[k]) / cell)));
+            if (c0[k] > c1[k]) outside = true;
+        }
+        if (outside) continue;
+        const double r2 = p.radius[i] * p.radius[i];
+        for (long a = c0[0]; a <= c1[0]; ++a)
+            for (long b = c0[1]; b <= c1[1]; ++b)
+                for (long c = c0[2]; c <= c1[2]; ++c) {
+                    double d2 = 0;
+                    const long idx[3] = {a, b, c};
+                    for (int k = 0; k < D; ++k) d2 += std::pow(centre(k, idx[k]) - p.x[i][k], 2);
+                    if (d2 <= r2) covered[(a * n[1] + b) * n[2] + c] = 1;
+                }
+    }
+    std::size_t s = 0;
+    for (auto v : covered) s += v;
+    return double(s) / covered.size();
+}
+
+/// Runs a settling scene to its duration and checks: nobody lost, kinetic energy below kineticMax (N m g d), bulk
+/// packing fraction (one diameter from side walls and floor, 1.5 diameters below the highest centre) in range.
+template <int D>
+void settle(const char* file, double kineticMax, double packMin, double packMax) {
+    const Scenario sc = dataScenario(file);
+    World<D> w = buildWorld<D>(sc);
+    const std::size_t n0 = w.particles.size();
+    TdmEngine<D> eng(w, tdmSettings<D>(sc, w));
+    eng.advanceTo(sc.duration);
+    const Particles<D>& p = w.particles;
+    ASSERT_EQ(p.size(), n0);
+    std::size_t lost = 0;
+    double rmax = 0, mgd = 0, zTop = -1e300;
+    const double g = norm(w.domain.gravity);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        bool out = false;
+        for (int k = 0; k < D; ++k)
+            if (!(p.x[i][k] >= w.domain.lo[k] && p.x[i][k] <= w.domain.hi[k])) out = true;
+        for (const Wall<D>& wl : w.walls)
+            if (!(wl.distance(p.x[i], w.time) > 0.9 * p.radius[i])) out = true;
+        lost += out;
+        rmax = std::max(rmax, p.radius[i]);
+        mgd += p.mass[i] * g * 2 * p.radius[i];
+        zTop = std::max(zTop, p.x[i][D - 1]);
+    }
+    const double d = 2 * rmax;
+    Vec<D> lo = w.domain.lo + Vec<D>::filled(d), hi = w.domain.hi - Vec<D>::filled(d);
+    hi[D - 1] = zTop - 1.5 * d;
+    const double packing = coveredFraction(p, lo, hi, 0.1 * rmax);
+    const double kin = kineticEnergy(p) / mgd;
+    record("packing", packing);
+    record("kinetic_ratio", kin);
+    EXPECT_EQ(lost, 0u);
+    EXPECT_LT(kin, kineticMax);
+    EXPECT_GT((hi[D - 1] - lo[D - 1]) / d, 3.0) << "the measured bulk region is too thin";
+    EXPECT_GE(packing, packMin);
+    EXPECT_LE(packing, packMax);
+}
+
+TEST(ValidateSettling, SpheresInClosedBox) { settle<3>("settle3d.toml", 1e-4, 0.55, 0.66); }
+TEST(ValidateSettling, DisksInClosedBox) { settle<2>("settle2d.toml", 1e-4, 0.78, 0.86); }
+
+}  // namespace
+}  // namespace haet
