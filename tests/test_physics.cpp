@@ -18,6 +18,7 @@
 #include "scenario/loader.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
+#include "physics_util.hpp"
 #include "world_util.hpp"
 
 namespace haet {
@@ -25,41 +26,11 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// A scene of tests/data/ (the same files `haet run` accepts).
-Scenario dataScenario(const std::string& name) {
-    return loadScenario(std::filesystem::path(HAET_SOURCE_DIR) / "tests" / "data" / name);
-}
-
-/// A measured value in the test's XML report (--gtest_output=xml), to follow margins over time.
-void record(const std::string& key, double value) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", value);
-    ::testing::Test::RecordProperty(key, buf);
-}
-
-/// Translational + rotational kinetic energy [J].
-template <int D>
-double kineticEnergy(const Particles<D>& p) {
-    double e = 0;
-    for (std::size_t i = 0; i < p.size(); ++i)
-        e += 0.5 * p.mass[i] * norm2(p.v[i]) + 0.5 * p.inertia(i) * norm2(p.w[i]);
-    return e;
-}
-
-template <int D>
-Vec<D> momentum(const Particles<D>& p) {
-    Vec<D> s = Vec<D>::zero();
-    for (std::size_t i = 0; i < p.size(); ++i) s += p.v[i] * p.mass[i];
-    return s;
-}
-
-/// Sum of |m v| over particles: the scale against which round-off in the total momentum is judged.
-template <int D>
-double momentumScale(const Particles<D>& p) {
-    double s = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) s += p.mass[i] * norm(p.v[i]);
-    return s;
-}
+using testing::dataScenario;
+using testing::kineticEnergy;
+using testing::momentum;
+using testing::momentumScale;
+using testing::record;
 
 // ------------------------------------------------------------------------------------------------------------
 // 1. Elastic gas in a fully periodic box: energy and momentum conservation
