@@ -1,0 +1,861 @@
+#include "edm/engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "edm/predict.hpp"
+
+namespace haet {
+
+// Arithmetic is canonical on purpose: a pair's collision time is computed from the two particles' stored states
+// extrapolated to the later of their two clocks (never to "now"), in a form that is bit-identical for (a, b) and
+// (b, a); the collision operator always takes the particle of lower World index as body 1. The prediction of a pair
+// therefore does not depend on when, or by which of the two, it was made, and the fast engine and the brute-force
+// reference produce bit-identical event sequences (tests/test_edm_engine.cpp). Stored states change only at
+// collisions and at the synchronisation at the end of advanceTo, never at cell crossings or stale events.
+
+template <int D>
+EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings) : w_(world), s_(settings) {
+    const ContactSetup& cs = w_.contact;
+    if (cs.nMaterials <= 0 || cs.table.size() < static_cast<std::size_t>(cs.nMaterials * cs.nMaterials))
+        throw std::invalid_argument("event-driven engine: the world has no contact table (world.contact)");
+    if (s_.tcTime < 0) throw std::invalid_argument("event-driven engine: tcTime must be >= 0");
+    if (s_.maxEventRate < 0) throw std::invalid_argument("event-driven engine: maxEventRate must be >= 0");
+    if (s_.cellSize < 0) throw std::invalid_argument("event-driven engine: cellSize must be >= 0");
+    tcRef_ = s_.tcTime > 0 ? s_.tcTime : cs.contactTime;
+    tc_ = (s_.tcModel && tcRef_ > 0) ? tcRef_ : 0;
+    g_ = w_.domain.gravity;
+    boxLen_ = w_.domain.length();
+    for (std::size_t k = 0; k < w_.walls.size(); ++k) {
+        const Wall<D>& wl = w_.walls[k];
+        if (wl.material < 0 || wl.material >= cs.nMaterials)
+            throw std::invalid_argument("event-driven engine: wall " + std::to_string(k) + " has no material");
+        for (int a = 0; a < D; ++a)
+            if (w_.domain.periodic[a] && std::abs(wl.normal[a]) > 1e-12)
+                throw std::invalid_argument("event-driven engine: wall " + std::to_string(k) +
+                                            " is not parallel to periodic axis " + std::to_string(a));
+    }
+    reset();
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// set-up
+
+template <int D>
+void EdmEngine<D>::reset() {
+    Particles<D>& p = w_.particles;
+    const std::size_t n = p.size();
+    if (n >= (1u << kTypeShift)) throw std::invalid_argument("event-driven engine: too many particles");
+    rmax_ = 0;
+    nMoving_ = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!(p.radius[i] > 0)) throw std::invalid_argument("event-driven engine: particle with radius <= 0");
+        if (p.material[i] >= w_.contact.nMaterials)
+            throw std::invalid_argument("event-driven engine: particle material outside the contact table");
+        rmax_ = std::max(rmax_, p.radius[i]);
+        if (!p.frozen(i)) ++nMoving_;
+    }
+    for (int k = 0; k < D; ++k)
+        if (w_.domain.periodic[k] && boxLen_[k] < 4 * rmax_)
+            throw std::invalid_argument("event-driven engine: periodic axis " + std::to_string(k) +
+                                        " is shorter than two particle diameters");
+    // Periodic positions into the box (frozen particles too: they never move afterwards).
+    for (std::size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < D; ++k) {
+            if (!w_.domain.periodic[k]) continue;
+            double& x = p.x[i][k];
+            const double lo = w_.domain.lo[k], L = boxLen_[k];
+            if (x >= lo && x < lo + L) continue;
+            const double s = std::floor((x - lo) / L);
+            x -= s * L;
+            p.image[i][k] += s * L;
+        }
+    }
+    // Event-rate bound (docs/edm.md): as given; else 1000 per TC time; else 10^4 per d_min/u, u the larger of
+    // the rms speed, sqrt(|g| d_min) and the fastest wall speed. Physical event rates stay far below.
+    if (s_.maxEventRate > 0) {
+        maxRate_ = s_.maxEventRate;
+    } else if (tcRef_ > 0) {
+        maxRate_ = 1000.0 / tcRef_;
+    } else {
+        double dmin = kNever, v2 = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            dmin = std::min(dmin, 2 * p.radius[i]);
+            if (!p.frozen(i)) v2 += norm2(p.v[i]);
+        }
+        double u = nMoving_ > 0 ? std::sqrt(v2 / static_cast<double>(nMoving_)) : 0;
+        if (n > 0) u = std::max(u, std::sqrt(norm(g_) * dmin));
+        for (const Wall<D>& wl : w_.walls) u = std::max(u, norm(wl.velocity));
+        maxRate_ = (n > 0 && u > 0) ? 1e4 * u / dmin : 0;
+    }
+    window_ = std::max<std::uint64_t>(1000000, 100 * static_cast<std::uint64_t>(nMoving_));
+    winEvents_ = events_;
+    winTime_ = w_.time;
+
+    // Slots in World order first, then sorted cell by cell.
+    buildGrid();
+    hot_.resize(n);
+    link_.assign(n, Link{kNil, 0, Shift{}});
+    rec_.assign(n, Rec{Candidate{}, -std::numeric_limits<double>::infinity(), kNone << kTypeShift, 0, kNil, 0});
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const bool fz = p.frozen(i);
+        hot_[i] = Hot{p.x[i], fz ? kNever : w_.time, fz ? Vec<D>::zero() : p.v[i], p.radius[i]};
+        rec_[i].idx = i;
+        rec_[i].cell = cellOf(p.x[i]);
+    }
+    queue_.reset(n);
+    resort();  // also links the cells
+    if (s_.reference) return;
+    for (std::uint32_t s = 0; s < n; ++s)
+        if (!frozen(s)) predict(s, w_.time);
+}
+
+template <int D>
+void EdmEngine<D>::buildGrid() {
+    double edge = s_.cellSize > 0 ? s_.cellSize : 2 * rmax_;
+    if (s_.cellSize > 0 && s_.cellSize < 2 * rmax_ * (1 - 1e-12))
+        throw std::invalid_argument("event-driven engine: cellSize is smaller than the largest diameter");
+    if (!(edge > 0)) edge = 1;
+    // At most max(2^20, 8 N) cells: a huge open box with few particles gets larger cells.
+    const double maxCells = std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size()));
+    for (;;) {
+        double total = 1;
+        for (int k = 0; k < D; ++k) {
+            const double L = boxLen_[k];
+            nCell_[k] = L > 0 ? std::max(1, static_cast<int>(std::floor(L / edge))) : 1;
+            total *= nCell_[k];
+        }
+        if (total <= maxCells) break;
+        edge *= 1.25;
+    }
+    std::uint32_t total = 1;
+    for (int k = 0; k < D; ++k) {
+        cellW_[k] = boxLen_[k] > 0 ? boxLen_[k] / nCell_[k] : 1;
+        stride_[k] = total;
+        total *= static_cast<std::uint32_t>(nCell_[k]);
+    }
+    head_.assign(total, kNil);
+    // Index offsets of the 3^D neighbours of a cell away from the faces, and of the 3^(D-1) new neighbours after a
+    // step along axis a in direction d (deltaSide_[2 a + (d > 0)]).
+    deltaFull_.clear();
+    for (auto& v : deltaSide_) v.clear();
+    constexpr int m = D == 3 ? 27 : 9;
+    for (int code = 0; code < m; ++code) {
+        std::array<int, D> o;
+        int t = code;
+        std::int32_t delta = 0;
+        for (int k = 0; k < D; ++k) {
+            o[k] = t % 3 - 1;
+            t /= 3;
+            delta += o[k] * static_cast<std::int32_t>(stride_[k]);
+        }
+        deltaFull_.push_back(delta);
+        for (int k = 0; k < D; ++k)
+            if (o[k] != 0) deltaSide_[2 * k + (o[k] > 0 ? 1 : 0)].push_back(delta);
+    }
+}
+
+template <int D>
+std::uint32_t EdmEngine<D>::cellOf(const Vec<D>& x) const {
+    std::uint32_t c = 0;
+    for (int k = 0; k < D; ++k) {
+        int ck = static_cast<int>(std::floor((x[k] - w_.domain.lo[k]) / cellW_[k]));
+        ck = std::clamp(ck, 0, nCell_[k] - 1);
+        c += static_cast<std::uint32_t>(ck) * stride_[k];
+    }
+    return c;
+}
+
+template <int D>
+void EdmEngine<D>::insertCell(std::uint32_t s, std::uint32_t c) {
+    rec_[s].cell = c;
+    rec_[s].prev = kNil;
+    link_[s].next = head_[c];
+    if (head_[c] != kNil) rec_[head_[c]].prev = s;
+    head_[c] = s;
+}
+
+template <int D>
+void EdmEngine<D>::removeCell(std::uint32_t s) {
+    const std::uint32_t nx = link_[s].next;
+    if (rec_[s].prev != kNil)
+        link_[rec_[s].prev].next = nx;
+    else
+        head_[rec_[s].cell] = nx;
+    if (nx != kNil) rec_[nx].prev = rec_[s].prev;
+}
+
+template <int D>
+void EdmEngine<D>::linkCells() {
+    std::fill(head_.begin(), head_.end(), kNil);
+    // Inserted from the last slot down, so each cell's list runs in increasing slot order.
+    for (std::uint32_t s = static_cast<std::uint32_t>(hot_.size()); s-- > 0;) insertCell(s, rec_[s].cell);
+}
+
+// Reorders the slots cell by cell (stable in the current order): neighbours in space become neighbours in memory.
+// Pending events move with their slots; the partners of pair events are renumbered.
+template <int D>
+void EdmEngine<D>::resort() {
+    const std::size_t n = hot_.size();
+    std::vector<std::uint32_t> start(head_.size() + 1, 0);
+    for (std::size_t s = 0; s < n; ++s) ++start[rec_[s].cell + 1];
+    for (std::size_t c = 0; c + 1 < start.size(); ++c) start[c + 1] += start[c];
+    std::vector<std::uint32_t> order(n), newSlot(n);  // order[new] = old
+    for (std::uint32_t s = 0; s < n; ++s) {
+        const std::uint32_t ns = start[rec_[s].cell]++;
+        order[ns] = s;
+        newSlot[s] = ns;
+    }
+    auto permute = [&](auto& arr) {
+        auto tmp = arr;
+        for (std::size_t k = 0; k < n; ++k) tmp[k] = arr[order[k]];
+        arr.swap(tmp);
+    };
+    permute(hot_);
+    permute(link_);
+    permute(rec_);
+    std::vector<double> times(n);
+    for (std::size_t k = 0; k < n; ++k) times[k] = queue_.time(order[k]);
+    auto renumber = [&](std::uint32_t& code) {
+        if ((code >> kTypeShift) == kPair) code = (kPair << kTypeShift) | newSlot[code & kIndexMask];
+    };
+    for (std::size_t k = 0; k < n; ++k) {
+        renumber(rec_[k].evCode);
+        renumber(rec_[k].coll.code);
+    }
+    queue_.build(times);
+    linkCells();
+    sortedAt_ = events_;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// motion and predictions
+
+template <int D>
+inline Vec<D> EdmEngine<D>::posAt(const Hot& h, double t) const {
+    if (h.t == kNever) return h.x;
+    const double dt = t - h.t;
+    Vec<D> x;
+    for (int k = 0; k < D; ++k) x[k] = h.x[k] + (h.v[k] + 0.5 * g_[k] * dt) * dt;
+    return x;
+}
+
+template <int D>
+inline Vec<D> EdmEngine<D>::velAt(const Hot& h, double t) const {
+    if (h.t == kNever) return Vec<D>::zero();
+    const double dt = t - h.t;
+    Vec<D> v;
+    for (int k = 0; k < D; ++k) v[k] = h.v[k] + g_[k] * dt;
+    return v;
+}
+
+template <int D>
+void EdmEngine<D>::advance(std::uint32_t s, double t) {
+    Hot& h = hot_[s];
+    if (h.t == kNever) return;
+    const double dt = t - h.t;
+    if (dt != 0) {
+        h.x = posAt(h, t);
+        h.v = velAt(h, t);
+        Particles<D>& p = w_.particles;
+        p.angle[rec_[s].idx] += p.w[rec_[s].idx] * dt;  // free rotation between collisions
+    }
+    h.t = t;
+}
+
+// Collision time of slots a (moving) and b, b seen through the periodic image shift m (multiples of the box
+// lengths), no earlier than now. horizon: an event already found; a frozen partner beyond reach before it is skipped.
+template <int D>
+inline double EdmEngine<D>::pairTime(std::uint32_t a, std::uint32_t b, const Shift& m, double now,
+                                     double horizon) const {
+    const Hot& ha = hot_[a];
+    const Hot& hb = hot_[b];
+    const double sigma = ha.r + hb.r;
+    double t;
+    if (hb.t == kNever) {
+        // A fixed obstacle: only a accelerates, the gap is a quartic under gravity. The quartic is costly, so
+        // first a conservative test whether a can reach the obstacle before the horizon; skipping changes
+        // nothing, since such a root could not be the earliest.
+        if (horizon < kNever) {
+            const double tau = horizon - now;
+            const Vec<D> xn = posAt(ha, now);
+            Vec<D> r0;
+            for (int k = 0; k < D; ++k) r0[k] = (xn[k] - hb.x[k]) + m[k] * boxLen_[k];
+            const double reach = norm(velAt(ha, now)) * tau + 0.5 * norm(g_) * tau * tau;
+            if (norm(r0) - sigma > reach * (1 + 1e-9) + 1e-12 * sigma) return kNever;
+        }
+        Vec<D> r;
+        for (int k = 0; k < D; ++k) r[k] = (ha.x[k] - hb.x[k]) + m[k] * boxLen_[k];
+        t = ha.t + fixedSphereCollisionTime(r, ha.v, g_, sigma, kNever);
+    } else {
+        // Both extrapolated to the later clock (one of the two extrapolations is by zero: exact).
+        const double tr = std::max(ha.t, hb.t);
+        const Vec<D> xa = posAt(ha, tr), xb = posAt(hb, tr);
+        const Vec<D> va = velAt(ha, tr), vb = velAt(hb, tr);
+        Vec<D> r;
+        for (int k = 0; k < D; ++k) r[k] = (xa[k] - xb[k]) + m[k] * boxLen_[k];
+        t = tr + pairCollisionTime(r, va - vb, sigma);
+    }
+    return t < now ? pairTimeFromNow(a, b, m, now) : t;
+}
+
+// A root before now means an invalid state at the stored clocks (an overlap that round-off, or a bug, let pass).
+// Its dynamics are decided by the state now (PHYSICS.md D.6): approaching now -> now; receding -> the next root
+// from now. Deciding from the older state could schedule a collision that collidePair then finds receding.
+template <int D>
+double EdmEngine<D>::pairTimeFromNow(std::uint32_t a, std::uint32_t b, const Shift& m, double now) const {
+    const Hot& ha = hot_[a];
+    const Hot& hb = hot_[b];
+    const Vec<D> xa = posAt(ha, now), xb = posAt(hb, now);
+    Vec<D> r;
+    for (int k = 0; k < D; ++k) r[k] = (xa[k] - xb[k]) + m[k] * boxLen_[k];
+    const Vec<D> va = velAt(ha, now);
+    const double tau = hb.t == kNever ? fixedSphereCollisionTime(r, va, g_, ha.r + hb.r, kNever)
+                                      : pairCollisionTime(r, va - velAt(hb, now), ha.r + hb.r);
+    return now + tau;
+}
+
+template <int D>
+double EdmEngine<D>::wallTime(std::uint32_t s, std::size_t w, double now) const {
+    const Hot& h = hot_[s];
+    const Wall<D>& wl = w_.walls[w];
+    const double t = h.t + wallCollisionTime(h.x, h.v, h.r, wl.pointAt(h.t), wl.velocity, wl.normal, g_);
+    if (t >= now) return t;
+    // Invalid state at the stored clock: decided by the state now, as for pairs.
+    return now + wallCollisionTime(posAt(h, now), velAt(h, now), h.r, wl.pointAt(now), wl.velocity, wl.normal, g_);
+}
+
+// Predicts the next event of slot s at time now: the earliest of its cell exit, its wall collisions and its
+// collisions with the particles of the 3^D neighbour cells. After a cell crossing (axis >= 0, dir = +-1) with a
+// still valid earlier result in rec_[s].coll, only the newly adjacent cells are scanned: the others were scanned
+// before and their particles' trajectories are unchanged (a particle that changed since re-predicted itself).
+template <int D>
+void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
+    const Domain<D>& dom = w_.domain;
+    const Hot& hs = hot_[s];
+    const Shift ws = link_[s].wrap;
+    // Cell coordinates, the faces s can leave through, and the neighbour cells per axis. The exit is computed from
+    // the state at "now": from the older stored state the quadratic can also find a crossing that already
+    // happened (through a face and back under gravity).
+    const Vec<D> xNow = posAt(hs, now), vNow = velAt(hs, now);
+    Candidate cross;
+    std::array<std::array<int, 3>, D> nbr, omega;
+    std::array<int, D> nbrCount, cc;
+    for (int k = 0; k < D; ++k) {
+        const int c = static_cast<int>((rec_[s].cell / stride_[k]) % static_cast<std::uint32_t>(nCell_[k]));
+        cc[k] = c;
+        const bool per = dom.periodic[k];
+        const double lo = (c == 0 && !per) ? -kNever : dom.lo[k] + c * cellW_[k];
+        const double hi = (c == nCell_[k] - 1 && !per) ? kNever : dom.lo[k] + (c + 1) * cellW_[k];
+        const CellExit ex = cellExitTime(xNow[k] - ws[k] * boxLen_[k], vNow[k], g_[k], lo, hi);
+        if (ex.time < kNever) {
+            const double t = now + ex.time;
+            const std::uint32_t code = (kCell << kTypeShift) | static_cast<std::uint32_t>(2 * k + (ex.up ? 1 : 0));
+            if (cross.better(t, code)) cross = {t, code, 0};
+        }
+        int m = 0;
+        for (int o = -1; o <= 1; ++o) {
+            if (k == axis && o != dir) continue;
+            int cn = c + o, om = 0;
+            if (cn < 0) {
+                if (!per) continue;
+                cn += nCell_[k];
+                om = -1;
+            } else if (cn >= nCell_[k]) {
+                if (!per) continue;
+                cn -= nCell_[k];
+                om = 1;
+            }
+            nbr[k][m] = cn;
+            omega[k][m] = om;
+            ++m;
+        }
+        nbrCount[k] = m;
+    }
+    Candidate best;
+    if (axis >= 0) {
+        best = rec_[s].coll;
+    } else {
+        for (std::size_t w = 0; w < w_.walls.size(); ++w) {
+            const double t = wallTime(s, w, now);
+            const std::uint32_t code = (kWall << kTypeShift) | static_cast<std::uint32_t>(w);
+            if (best.better(t, code)) best = {t, code, 0};
+        }
+    }
+    // Neighbour cells. Their list heads are loaded first and the first member of each list prefetched, so that the
+    // cache misses overlap instead of following each other. A cell away from the box faces takes its neighbours
+    // from a table of index offsets; one at a face (open or periodic) goes through the per-axis lists.
+    constexpr int kMaxCells = D == 3 ? 27 : 9;
+    std::uint32_t heads[kMaxCells];
+    Shift bases[kMaxCells];
+    int nc = 0;
+    bool interior = true;
+    for (int k = 0; k < D; ++k) interior = interior && cc[k] >= 1 && cc[k] <= nCell_[k] - 2;
+    const Shift negWs = [&] {
+        Shift r;
+        for (int k = 0; k < D; ++k) r[k] = -ws[k];
+        return r;
+    }();
+    if (interior) {
+        const std::vector<std::int32_t>& deltas = axis < 0 ? deltaFull_ : deltaSide_[2 * axis + (dir > 0 ? 1 : 0)];
+        const std::uint32_t c0 = rec_[s].cell;
+        for (const std::int32_t dl : deltas) heads[nc++] = head_[c0 + static_cast<std::uint32_t>(dl)];
+    } else {
+        bool any = true;
+        for (int k = 0; k < D; ++k) any = any && nbrCount[k] > 0;
+        std::array<int, D> at{};
+        while (any) {
+            std::uint32_t cellIndex = 0;
+            for (int k = 0; k < D; ++k) {
+                cellIndex += static_cast<std::uint32_t>(nbr[k][at[k]]) * stride_[k];
+                bases[nc][k] = -ws[k] - omega[k][at[k]];
+            }
+            heads[nc++] = head_[cellIndex];
+            int k = 0;
+            while (k < D && ++at[k] == nbrCount[k]) at[k++] = 0;
+            if (k == D) break;
+        }
+    }
+    for (int q = 0; q < nc; ++q) {
+        if (heads[q] == kNil) continue;
+        __builtin_prefetch(&hot_[heads[q]]);
+        __builtin_prefetch(&link_[heads[q]]);
+    }
+    // The canonical form of pairTime, written out for speed: the older of the two states is extrapolated to the
+    // other's clock (an extrapolation by zero leaves a state unchanged, so skipping it gives the same bits).
+    // Candidates later than the best pair or wall event so far are skipped before the square root, but never
+    // because they are later than the cell exit: rec_[s].coll must stay the earliest over all neighbours for the
+    // partial scans after a crossing.
+    const double ts = hs.t;
+    double gHalf[D];
+    for (int k = 0; k < D; ++k) gHalf[k] = 0.5 * g_[k];
+    for (int q = 0; q < nc; ++q) {
+        const Shift& base = interior ? negWs : bases[q];
+        for (std::uint32_t j = heads[q]; j != kNil;) {
+            const Link& lj = link_[j];
+            const std::uint32_t nextJ = lj.next;
+            if (j != s) {
+                const Hot& hj = hot_[j];
+                double t = kNever;
+                if (hj.t == kNever) {
+                    Shift m;
+                    for (int k = 0; k < D; ++k) m[k] = base[k] + lj.wrap[k];
+                    t = pairTime(s, j, m, now, best.time);
+                } else {
+                    double r[D], v[D], tr;
+                    if (hj.t <= ts) {
+                        tr = ts;
+                        const double db = ts - hj.t;
+                        for (int k = 0; k < D; ++k) {
+                            const double xb = hj.x[k] + (hj.v[k] + gHalf[k] * db) * db;
+                            r[k] = (hs.x[k] - xb) + (base[k] + lj.wrap[k]) * boxLen_[k];
+                            v[k] = hs.v[k] - (hj.v[k] + g_[k] * db);
+                        }
+                    } else {
+                        tr = hj.t;
+                        const double da = hj.t - ts;
+                        for (int k = 0; k < D; ++k) {
+                            const double xa = hs.x[k] + (hs.v[k] + gHalf[k] * da) * da;
+                            r[k] = (xa - hj.x[k]) + (base[k] + lj.wrap[k]) * boxLen_[k];
+                            v[k] = (hs.v[k] + g_[k] * da) - hj.v[k];
+                        }
+                    }
+                    double b = 0;
+                    for (int k = 0; k < D; ++k) b += r[k] * v[k];
+                    if (b < 0) {
+                        const double sigma = hs.r + hj.r;
+                        double r2 = 0;
+                        for (int k = 0; k < D; ++k) r2 += r[k] * r[k];
+                        const double c = r2 - sigma * sigma;
+                        // Lower bound of the root: c / (-2 b). Beyond the best event so far: no sqrt, no division.
+                        const double left = best.time - tr;
+                        if (!(c > 0 && c > -2 * b * left * (1 + 1e-12))) {
+                            double v2 = 0;
+                            for (int k = 0; k < D; ++k) v2 += v[k] * v[k];
+                            t = tr + firstRootFalling(c, 2 * b, 2 * v2);
+                            if (t < now) {
+                                Shift m;
+                                for (int k = 0; k < D; ++k) m[k] = base[k] + lj.wrap[k];
+                                t = pairTimeFromNow(s, j, m, now);
+                            }
+                        }
+                    }
+                }
+                const std::uint32_t code = (kPair << kTypeShift) | j;
+                if (best.better(t, code)) best = {t, code, lj.count};
+            }
+            j = nextJ;
+        }
+    }
+    rec_[s].coll = best;
+    const Candidate& next = cross.better(best.time, best.code) ? best : cross;
+    rec_[s].evCode = next.code;
+    queue_.update(s, next.time);
+}
+
+template <int D>
+void EdmEngine<D>::crossCell(std::uint32_t s, int axis, bool up) {
+    const int c = static_cast<int>((rec_[s].cell / stride_[axis]) % static_cast<std::uint32_t>(nCell_[axis]));
+    int cn = c + (up ? 1 : -1);
+    if (cn >= nCell_[axis]) {  // only on periodic axes: outer cells of open axes are unbounded
+        cn = 0;
+        link_[s].wrap[axis] += 1;
+    } else if (cn < 0) {
+        cn = nCell_[axis] - 1;
+        link_[s].wrap[axis] -= 1;
+    }
+    const std::uint32_t newCell =
+        rec_[s].cell + (static_cast<std::uint32_t>(cn) - static_cast<std::uint32_t>(c)) * stride_[axis];
+    removeCell(s);
+    insertCell(s, newCell);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// collisions
+
+template <int D>
+CollisionLaw EdmEngine<D>::lawFor(int matA, int matB, bool elastic) const {
+    const PairCoeffs& c = w_.contact.pair(matA, matB);
+    CollisionLaw law;
+    law.mu = c.mu;
+    if (elastic) {
+        // TC model: elastic in the normal direction, no tangential impulse (beta = -1): the limit of Walton's
+        // rule for vanishing normal impulse, which never violates Coulomb's bound (docs/edm.md).
+        law.e = 1;
+        law.beta0 = -1;
+        law.rule = BetaRule::Constant;
+    } else {
+        law.e = c.restitution;
+        law.beta0 = c.beta0;
+        law.rule = s_.tangential == EdmSettings::Tangential::Walton ? BetaRule::Walton : BetaRule::Constant;
+    }
+    return law;
+}
+
+template <int D>
+bool EdmEngine<D>::tcElastic(std::uint32_t a, std::uint32_t b, double t) const {
+    if (!(tc_ > 0)) return false;
+    if (t - rec_[a].tLast < tc_) return true;
+    return b != kNil && t - rec_[b].tLast < tc_;
+}
+
+template <int D>
+void EdmEngine<D>::notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop,
+                          const Vec<D>& P) {
+    if (!observer_) return;
+    EdmCollision<D> c;
+    c.time = t;
+    c.i = rec_[a].idx;
+    c.partner = wall ? partner : rec_[partner].idx;
+    c.wall = wall;
+    c.elastic = elastic;
+    c.restHop = hop;
+    c.impulse = P;
+    observer_(c);
+}
+
+template <int D>
+void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
+    Particles<D>& p = w_.particles;
+    // Canonical order: the lower World index is body 1 (a frozen partner always body 2), so the result does not
+    // depend on which of the two particles' events found the collision (the operator's sums are not associative).
+    if ((rec_[b].idx < rec_[a].idx && !frozen(b)) || frozen(a)) std::swap(a, b);
+    const std::uint32_t i = rec_[a].idx, j = rec_[b].idx;
+    const bool fb = frozen(b);
+    // The state at t, committed only if the collision happens (a skipped event leaves no trace).
+    const Vec<D> va = velAt(hot_[a], t), vb = velAt(hot_[b], t);
+    Vec<D> d = posAt(hot_[a], t) - posAt(hot_[b], t);
+    for (int k = 0; k < D; ++k)
+        if (w_.domain.periodic[k]) d[k] += -std::nearbyint(d[k] / boxLen_[k]) * boxLen_[k];
+    const double bdot = dot(d, va - vb);
+    const Vec<D> n = d * (1.0 / norm(d));
+    // Rest hop (docs/edm.md): against a fixed obstacle that gravity pushes the particle into, the normal speed
+    // after the collision is at least |n.g| tcTime: it hops with a flight of 2 tcTime instead of coming to rest
+    // through infinitely many collisions.
+    const double gAcc = fb ? dot(n, g_) : 0;
+    const double uRest = (tc_ > 0 && gAcc < 0) ? -gAcc * tc_ : 0;
+    CollisionBody<D> b1{va, p.w[i], hot_[a].r, p.invMass[i], p.invInertia[i]};
+    CollisionBody<D> b2{vb, p.w[j], hot_[b].r, fb ? 0.0 : p.invMass[j], fb ? 0.0 : p.invInertia[j]};
+    const double gn = dot(contactVelocity(b1, b2, n), n);
+    const bool approaching = bdot < 0 && gn < 0;
+    if (!approaching && !(uRest > gn)) {  // not approaching (grazing, round-off): nothing happens
+        ++stats_.grazing;
+        return;
+    }
+    advance(a, t);
+    advance(b, t);
+    const bool elastic = tcElastic(a, fb ? kNil : b, t);
+    CollisionLaw law = lawFor(p.material[i], p.material[j], elastic);
+    Vec<D> P;
+    bool hop = false;
+    if (approaching) {
+        CollisionImpulse<D> imp = collisionImpulse(b1, b2, n, law);
+        if (uRest > 0 && -imp.e * imp.gn < uRest) {
+            law.e = uRest / -imp.gn;
+            imp = collisionImpulse(b1, b2, n, law);
+            hop = true;
+        }
+        P = imp.impulse;
+    } else {  // resting on the obstacle: a normal impulse up to the rest-hop speed
+        P = n * ((uRest - gn) / (b1.invMass + b2.invMass));
+        hop = true;
+    }
+    applyImpulse(b1, b2, n, P);
+    hot_[a].v = b1.v;
+    p.w[i] = b1.w;
+    ++link_[a].count;
+    rec_[a].tLast = t;
+    if (!fb) {
+        hot_[b].v = b2.v;
+        p.w[j] = b2.w;
+        ++link_[b].count;
+        rec_[b].tLast = t;
+    }
+    virial_ += dot(d, P);
+    ++stats_.pairCollisions;
+    if (elastic) ++stats_.tcElastic;
+    if (hop) ++stats_.restHops;
+    notify(t, a, b, false, elastic, hop, P);
+}
+
+template <int D>
+void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
+    Particles<D>& p = w_.particles;
+    const std::uint32_t i = rec_[s].idx;
+    const Wall<D>& wl = w_.walls[w];
+    const Vec<D>& n = wl.normal;
+    const double gAcc = dot(n, g_);
+    const double uRest = (tc_ > 0 && gAcc < 0) ? -gAcc * tc_ : 0;
+    const Vec<D> vs = velAt(hot_[s], t);
+    CollisionBody<D> b1{vs, p.w[i], hot_[s].r, p.invMass[i], p.invInertia[i]};
+    CollisionBody<D> b2{wl.velocity, Ang<D>::zero(), 0.0, 0.0, 0.0};
+    const double gn = dot(vs - wl.velocity, n);
+    if (gn >= 0 && !(uRest > gn)) {  // not approaching: nothing happens, no state change
+        ++stats_.grazing;
+        return;
+    }
+    advance(s, t);
+    const bool elastic = tcElastic(s, kNil, t);
+    CollisionLaw law = lawFor(p.material[i], wl.material, elastic);
+    Vec<D> P;
+    bool hop = false;
+    if (gn < 0) {
+        CollisionImpulse<D> imp = collisionImpulse(b1, b2, n, law);
+        if (uRest > 0 && -imp.e * imp.gn < uRest) {
+            law.e = uRest / -imp.gn;
+            imp = collisionImpulse(b1, b2, n, law);
+            hop = true;
+        }
+        P = imp.impulse;
+    } else {
+        P = n * ((uRest - gn) / b1.invMass);
+        hop = true;
+    }
+    applyImpulse(b1, b2, n, P);
+    hot_[s].v = b1.v;
+    p.w[i] = b1.w;
+    ++link_[s].count;
+    rec_[s].tLast = t;
+    ++stats_.wallCollisions;
+    if (elastic) ++stats_.tcElastic;
+    if (hop) ++stats_.restHops;
+    notify(t, s, w, true, elastic, hop, P);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// the event loop
+
+template <int D>
+void EdmEngine<D>::countEvent(double t) {
+    ++events_;
+    if (events_ - winEvents_ < window_) return;
+    const double span = t - winTime_;
+    const double perParticle = static_cast<double>(window_) / static_cast<double>(std::max<std::size_t>(1, nMoving_));
+    const bool tooFast = maxRate_ > 0 ? perParticle > maxRate_ * span : !(span > 0);
+    if (tooFast) {
+        std::ostringstream msg;
+        msg << "event-driven engine: " << window_ << " events in " << span << " s of simulated time before t = " << t
+            << " s (" << perParticle / span << " events per particle per second";
+        if (maxRate_ > 0) msg << ", bound " << maxRate_;
+        msg << "): inelastic collapse or a zero-time loop";
+        if (!(tc_ > 0)) msg << "; the TC model is off";
+        throw SimulationError(msg.str());
+    }
+    winEvents_ = events_;
+    winTime_ = t;
+}
+
+template <int D>
+void EdmEngine<D>::processNext() {
+    const std::uint32_t s = queue_.top();
+    const double t = queue_.topTime();
+    countEvent(t);
+    const std::uint32_t code = rec_[s].evCode;
+    const std::uint32_t k = code & kIndexMask;
+    switch (code >> kTypeShift) {
+        case kPair:
+            if (link_[k].count != rec_[s].coll.stamp) {  // the partner collided since: re-predict
+                ++stats_.stale;
+                predict(s, t);
+                return;
+            }
+            collidePair(s, k, t);
+            predict(s, t);
+            if (!frozen(k)) predict(k, t);
+            return;
+        case kWall:
+            collideWall(s, k, t);
+            predict(s, t);
+            return;
+        case kCell: {
+            ++stats_.cellCrossings;
+            const int axis = static_cast<int>(k >> 1);
+            const bool up = k & 1;
+            crossCell(s, axis, up);
+            // The earlier scan's best pair or wall event stays valid unless its partner collided since.
+            const Candidate& c = rec_[s].coll;
+            const bool valid = (c.code >> kTypeShift) != kPair || link_[c.code & kIndexMask].count == c.stamp;
+            if (valid)
+                predict(s, t, axis, up ? 1 : -1);
+            else
+                predict(s, t);
+            return;
+        }
+        default:
+            queue_.update(s, kNever);
+            return;
+    }
+}
+
+template <int D>
+void EdmEngine<D>::synchronise(double t) {
+    Particles<D>& p = w_.particles;
+    const Domain<D>& dom = w_.domain;
+    for (std::uint32_t s = 0; s < hot_.size(); ++s) {
+        if (frozen(s)) continue;
+        advance(s, t);
+        Hot& h = hot_[s];
+        const std::uint32_t i = rec_[s].idx;
+        for (int k = 0; k < D; ++k) {
+            if (!dom.periodic[k]) continue;
+            double& x = h.x[k];
+            const double lo = dom.lo[k], L = boxLen_[k];
+            if (x >= lo && x < lo + L) continue;
+            const double sh = std::floor((x - lo) / L);
+            x -= sh * L;
+            p.image[i][k] += sh * L;
+            // The box-frame position x - wrap L is unchanged, so the cell and the pending events stay valid.
+            link_[s].wrap[k] -= static_cast<std::int32_t>(sh);
+        }
+        p.x[i] = h.x;
+        p.v[i] = h.v;
+        if (!std::isfinite(norm2(h.x) + norm2(h.v) + norm2(p.w[i]))) {
+            std::ostringstream msg;
+            msg << "event-driven engine: particle " << p.id[i] << " (index " << i
+                << ") has a non-finite state at t = " << t << " s";
+            throw SimulationError(msg.str());
+        }
+    }
+    w_.time = t;
+}
+
+template <int D>
+void EdmEngine<D>::advanceReference(double t) {
+    const Domain<D>& dom = w_.domain;
+    const std::uint32_t n = static_cast<std::uint32_t>(hot_.size());
+    double now = w_.time;
+    // Within the horizon every particle moves less than delta, so a pair that collides is at its minimum
+    // image now (|r| <= sigma + 2 delta <= L/2): the minimum image is enough.
+    double lmin = kNever;
+    for (int k = 0; k < D; ++k)
+        if (dom.periodic[k]) lmin = std::min(lmin, boxLen_[k]);
+    const double delta = 0.5 * (0.5 * lmin - 2 * rmax_);
+    const double gAbs = norm(g_);
+    for (;;) {
+        double horizon = kNever;
+        if (lmin < kNever) {
+            double vmax = 0;
+            for (std::uint32_t s = 0; s < n; ++s)
+                if (!frozen(s)) vmax = std::max(vmax, norm(velAt(hot_[s], now)));
+            horizon = now + 2 * delta / (vmax + std::sqrt(vmax * vmax + 2 * gAbs * delta));
+        }
+        double bestT = kNever;
+        std::uint32_t bestS = 0, bestCode = kNone << kTypeShift;
+        for (std::uint32_t s = 0; s < n; ++s) {
+            if (frozen(s)) continue;
+            Candidate c;
+            for (std::size_t w = 0; w < w_.walls.size(); ++w) {
+                const double tw = wallTime(s, w, now);
+                const std::uint32_t code = (kWall << kTypeShift) | static_cast<std::uint32_t>(w);
+                if (c.better(tw, code)) c = {tw, code, 0};
+            }
+            const Vec<D> xs = posAt(hot_[s], now);
+            for (std::uint32_t j = 0; j < n; ++j) {
+                if (j == s) continue;
+                const Vec<D> d = xs - posAt(hot_[j], now);
+                Shift m{};
+                for (int k = 0; k < D; ++k)
+                    if (dom.periodic[k]) m[k] = -static_cast<std::int32_t>(std::nearbyint(d[k] / boxLen_[k]));
+                const double tp = pairTime(s, j, m, now, c.time);
+                const std::uint32_t code = (kPair << kTypeShift) | j;
+                if (c.better(tp, code)) c = {tp, code, 0};
+            }
+            if (c.time < bestT) {
+                bestT = c.time;
+                bestS = s;
+                bestCode = c.code;
+            }
+        }
+        if (std::min(bestT, horizon) >= t) break;
+        if (horizon < bestT) {
+            now = horizon;
+            continue;
+        }
+        countEvent(bestT);
+        now = bestT;
+        const std::uint32_t k = bestCode & kIndexMask;
+        if ((bestCode >> kTypeShift) == kPair)
+            collidePair(bestS, k, bestT);
+        else
+            collideWall(bestS, k, bestT);
+    }
+}
+
+template <int D>
+void EdmEngine<D>::advanceTo(double t) {
+    if (t < w_.time) throw std::invalid_argument("event-driven engine: advanceTo into the past");
+    if (s_.reference) {
+        advanceReference(t);
+    } else {
+        while (queue_.size() > 0 && queue_.topTime() < t) processNext();
+    }
+    synchronise(t);
+    // Particles diffuse away from their sorted neighbours; re-sort after ~20 events per particle.
+    if (!s_.reference && events_ - sortedAt_ > 20 * static_cast<std::uint64_t>(hot_.size())) resort();
+}
+
+template <int D>
+double EdmEngine<D>::cellSize() const {
+    double c = kNever;
+    for (int k = 0; k < D; ++k) c = std::min(c, cellW_[k]);
+    return c;
+}
+
+template <int D>
+double EdmEngine<D>::nextEventTime() const {
+    return (!s_.reference && queue_.size() > 0) ? queue_.topTime() : kNever;
+}
+
+template <int D>
+std::size_t EdmEngine<D>::memoryBytes() const {
+    auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+    return bytes(hot_) + bytes(link_) + bytes(rec_) + queue_.memoryBytes() + bytes(head_);
+}
+
+template class EdmEngine<2>;
+template class EdmEngine<3>;
+
+}  // namespace haet

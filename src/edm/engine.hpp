@@ -1,0 +1,193 @@
+#pragma once
+// Event-driven engine for hard disks (D = 2) and spheres (D = 3): Lubachevsky's scheme (PHYSICS.md D.1) with
+// one pending event per particle, collision counters for stale events, per-particle clocks (lazy updates), a
+// cell grid with cell-crossing events, periodic images, moving plane walls, gravity, frozen particles, the
+// rough-particle collision operator with Walton's rule (C), and the TC model against inelastic collapse (D.7).
+// docs/edm.md describes the algorithm, the invalid-state rules and the defaults.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "edm/collision.hpp"
+#include "edm/event_queue.hpp"
+#include "edm/predict.hpp"
+#include "world/world.hpp"
+
+namespace haet {
+
+struct EdmSettings {
+    /// Edge of the event grid's cells [m]; 0: the largest particle diameter. Must not be smaller than that.
+    double cellSize = 0;
+    /// Tangential restitution: Walton's rule with (e, mu, beta0) of the material pair, or beta = beta0 always.
+    enum class Tangential { Walton, Constant } tangential = Tangential::Walton;
+    /// TC model (PHYSICS.md A.4, D.7): a collision less than tcTime after the previous collision of either
+    /// particle is elastic (e = 1, beta = -1). Also enables the rest hop on walls and frozen particles.
+    bool tcModel = true;
+    /// TC model time [s]; 0: the TDM contact duration world.contact.contactTime.
+    double tcTime = 0;
+    /// Bound on the event rate [events per moving particle per second of simulated time], checked over windows
+    /// of max(10^6, 100 N) events; above it the run stops with SimulationError (inelastic collapse, zero-time
+    /// loop). 0: 1000 / tcTime (also when the TC model is off); without any TC time 10^4 u / d_min, where u is
+    /// the largest of the rms particle speed, sqrt(|g| d_min) and the fastest wall speed at the start.
+    double maxEventRate = 0;
+    /// Reference twin: the next event by brute force (all pairs and all walls at every event, O(N^2) per event),
+    /// no cells, no queue. For tests.
+    bool reference = false;
+};
+
+/// One collision as seen by an observer (tests, diagnostics).
+template <int D>
+struct EdmCollision {
+    double time = 0;            ///< [s]
+    std::uint32_t i = 0;        ///< particle index
+    std::uint32_t partner = 0;  ///< particle index, or wall index when wall is true
+    bool wall = false;
+    bool elastic = false;  ///< made elastic by the TC model
+    bool restHop = false;  ///< normal speed raised to the rest-hop speed (wall or frozen partner)
+    Vec<D> impulse;        ///< impulse on particle i [N s]
+};
+
+/// Counts of what the engine did.
+struct EdmStats {
+    std::uint64_t pairCollisions = 0, wallCollisions = 0;
+    std::uint64_t cellCrossings = 0;  ///< cell-crossing events
+    std::uint64_t stale = 0;          ///< events found invalid (partner collided since) and re-predicted
+    std::uint64_t tcElastic = 0;      ///< collisions made elastic by the TC model
+    std::uint64_t restHops = 0;       ///< collisions whose normal speed was raised to the rest-hop speed
+    std::uint64_t grazing = 0;        ///< predicted collisions found not approaching (round-off), skipped
+};
+
+template <int D>
+class EdmEngine {
+public:
+    /// Takes the particles' state at world.time. Throws std::invalid_argument for unusable settings or worlds
+    /// (cell size below the largest diameter, periodic box shorter than two diameters, no contact table).
+    EdmEngine(World<D>& world, const EdmSettings& settings);
+
+    /// Processes all events before t, then brings every particle to time t (positions and velocities under
+    /// gravity; periodic positions wrapped into the box, wraps recorded in Particles::image); world.time = t.
+    /// Between calls the World holds the state at world.time; during a call the engine's own copy is current.
+    /// Throws SimulationError if the event rate exceeds the bound (EdmSettings::maxEventRate) or a particle's
+    /// state is not finite.
+    void advanceTo(double t);
+
+    /// Re-reads every particle from the World (after outside changes at world.time: positions, velocities,
+    /// frozen flags, particles added or removed) and re-predicts all events. The engine keeps its own copy of
+    /// positions and velocities, so outside changes are lost at the next advanceTo without it.
+    void reset();
+
+    std::uint64_t events() const { return events_; }  ///< events processed (collisions, crossings, stale)
+    std::uint64_t collisions() const { return stats_.pairCollisions + stats_.wallCollisions; }
+    const EdmStats& stats() const { return stats_; }
+    /// Sum of r_ij . dp_i over pair collisions since the last call [J] (PHYSICS.md E.2); walls excluded.
+    double takeCollisionVirial() {
+        const double v = virial_;
+        virial_ = 0;
+        return v;
+    }
+    /// Called after every collision (pair or wall). Leave empty for speed.
+    void setObserver(std::function<void(const EdmCollision<D>&)> f) { observer_ = std::move(f); }
+
+    const EdmSettings& settings() const { return s_; }
+    double tcTime() const { return tc_; }  ///< the TC time in use [s] (0: TC model off)
+    double cellSize() const;               ///< smallest cell edge of the grid [m]
+    double nextEventTime() const;          ///< time of the next pending event [s]
+    std::size_t memoryBytes() const;       ///< heap memory of the engine's own arrays [bytes]
+
+private:
+    enum Type : std::uint32_t { kPair = 0, kWall = 1, kCell = 2, kNone = 3 };
+    static constexpr std::uint32_t kTypeShift = 30, kIndexMask = (1u << kTypeShift) - 1;
+    static constexpr std::uint32_t kNil = 0xFFFFFFFFu;
+    using Shift = std::array<std::int32_t, D>;
+
+    // The engine works on slots, its own order of the particles (cell by cell, for memory locality); Rec::idx maps
+    // a slot to the particle's index in the World. What a prediction reads of a neighbour is in two records: Hot
+    // (one 64-byte cache line in 3D) and Link. The World's x and v are written at synchronisation only.
+    struct alignas(D == 3 ? 64 : 16) Hot {
+        Vec<D> x;  // position at time t [m]; raw: the periodic wraps since the last synchronisation are in wrap
+        double t;  // the particle's clock [s]; kNever marks a frozen particle (never moves)
+        Vec<D> v;  // velocity at time t [m/s]
+        double r;  // radius [m]
+    };
+    struct Link {
+        std::uint32_t next;   // next slot in the same cell
+        std::uint32_t count;  // collision counter (stale-event test)
+        Shift wrap;           // box-frame position = x - wrap * L on periodic axes
+    };
+    struct Candidate {
+        double time = kNever;
+        std::uint32_t code = kNone << kTypeShift;
+        std::uint32_t stamp = 0;
+        bool better(double t, std::uint32_t c) const { return t < time || (t == time && c < code); }
+    };
+
+    void buildGrid();
+    std::uint32_t cellOf(const Vec<D>& x) const;
+    void linkCells();
+    void insertCell(std::uint32_t s, std::uint32_t c);
+    void removeCell(std::uint32_t s);
+    void resort();
+    void predict(std::uint32_t s, double now, int axis = -1, int dir = 0);
+    double pairTime(std::uint32_t a, std::uint32_t b, const Shift& m, double now, double horizon) const;
+    double pairTimeFromNow(std::uint32_t a, std::uint32_t b, const Shift& m, double now) const;
+    double wallTime(std::uint32_t s, std::size_t w, double now) const;
+    void processNext();
+    void advanceReference(double t);
+    void collidePair(std::uint32_t a, std::uint32_t b, double t);
+    void collideWall(std::uint32_t s, std::uint32_t w, double t);
+    void crossCell(std::uint32_t s, int axis, bool up);
+    void advance(std::uint32_t s, double t);
+    void synchronise(double t);
+    void countEvent(double t);
+    Vec<D> posAt(const Hot& h, double t) const;
+    Vec<D> velAt(const Hot& h, double t) const;
+    bool frozen(std::uint32_t s) const { return hot_[s].t == kNever; }
+    CollisionLaw lawFor(int matA, int matB, bool elastic) const;
+    bool tcElastic(std::uint32_t a, std::uint32_t b, double t) const;  // b = kNil: wall or frozen partner
+    void notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop, const Vec<D>& P);
+
+    World<D>& w_;
+    EdmSettings s_;
+    double tc_ = 0;       // TC time in use (0: off)
+    double tcRef_ = 0;    // TC time, or the contact duration, whether the TC model is on or off [s]
+    double maxRate_ = 0;  // events per moving particle per second (0: none)
+    Vec<D> g_;            // gravity
+    Vec<D> boxLen_;       // box lengths
+    std::size_t nMoving_ = 0;
+    double rmax_ = 0;
+
+    // per slot
+    std::vector<Hot> hot_;
+    std::vector<Link> link_;
+    // What an event of the slot itself needs, in one cache line
+    struct Rec {
+        Candidate coll;        // earliest pair or wall event found by the last scan (code, partner's counter)
+        double tLast;          // time of the last collision (TC model)
+        std::uint32_t evCode;  // pending event: coll's code or a cell crossing (2 axis + up)
+        std::uint32_t cell;    // cell index
+        std::uint32_t prev;    // previous slot in the cell's list
+        std::uint32_t idx;     // slot -> World index
+    };
+    std::vector<Rec> rec_;
+    EventTree queue_;  // pending event times
+    // cell grid (linked lists with O(1) move)
+    std::vector<std::uint32_t> head_;
+    std::vector<std::int32_t> deltaFull_;                     // neighbour cell offsets (cells away from the faces)
+    std::array<std::vector<std::int32_t>, 2 * D> deltaSide_;  // new neighbours after a crossing
+    std::array<int, D> nCell_{};
+    std::array<std::uint32_t, D> stride_{};
+    Vec<D> cellW_;
+
+    std::uint64_t events_ = 0, sortedAt_ = 0;
+    EdmStats stats_;
+    double virial_ = 0;
+    std::uint64_t window_ = 0, winEvents_ = 0;
+    double winTime_ = 0;
+    std::function<void(const EdmCollision<D>&)> observer_;
+};
+
+extern template class EdmEngine<2>;
+extern template class EdmEngine<3>;
+
+}  // namespace haet

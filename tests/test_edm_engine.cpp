@@ -1,0 +1,335 @@
+// The event-driven engine: fast engine against the brute-force reference (same event sequence), conservation,
+// periodic wrapping, moving walls, frozen particles, the TC model and the collapse guard.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "test_edm_util.hpp"
+
+namespace haet {
+namespace {
+
+using testing::edmContact;
+using testing::GasSpec;
+using testing::kineticEnergyEdm;
+using testing::makeGas;
+
+struct LoggedCollision {
+    double time;
+    std::uint32_t a, b;  // a < b for pairs; b = wall index for walls
+    bool wall;
+};
+
+template <int D>
+std::vector<LoggedCollision> runLogged(World<D> w, const EdmSettings& s, double tEnd) {
+    std::vector<LoggedCollision> log;
+    EdmEngine<D> eng(w, s);
+    eng.setObserver([&](const EdmCollision<D>& c) {
+        if (c.wall)
+            log.push_back({c.time, c.i, c.partner, true});
+        else
+            log.push_back({c.time, std::min(c.i, c.partner), std::max(c.i, c.partner), false});
+    });
+    eng.advanceTo(tEnd);
+    return log;
+}
+
+/// Time of the minCollisions-th collision of the fast engine (a run stopped by its observer).
+template <int D>
+double timeForCollisions(World<D> w, const EdmSettings& s, std::size_t minCollisions) {
+    struct Stop {
+        double t;
+    };
+    EdmEngine<D> eng(w, s);
+    std::size_t count = 0;
+    eng.setObserver([&](const EdmCollision<D>& c) {
+        if (++count == minCollisions) throw Stop{c.time};
+    });
+    try {
+        eng.advanceTo(1e6);
+    } catch (const Stop& stop) {
+        return stop.t;
+    }
+    return 1e6;
+}
+
+/// The fast engine and the reference twin process the same collisions in the same order at the same times.
+/// Both run with one advanceTo: the synchronisation at its end changes the stored states' last bits, after
+/// which events pending from before would differ from fresh predictions in the last bits.
+template <int D>
+void compareWithReference(World<D> w, EdmSettings s, std::size_t minCollisions) {
+    s.reference = false;
+    const double tEnd = std::nextafter(timeForCollisions(w, s, minCollisions), kNever);
+    const auto fast = runLogged(w, s, tEnd);
+    s.reference = true;
+    const auto ref = runLogged(w, s, tEnd);
+    std::size_t exact = 0;
+    for (std::size_t k = 0; k < std::min(ref.size(), fast.size()); ++k) {
+        ASSERT_EQ(fast[k].wall, ref[k].wall) << "collision " << k;
+        ASSERT_EQ(fast[k].a, ref[k].a) << "collision " << k;
+        ASSERT_EQ(fast[k].b, ref[k].b) << "collision " << k;
+        ASSERT_NEAR(fast[k].time, ref[k].time, 1e-9 * std::abs(ref[k].time)) << "collision " << k;
+        exact += fast[k].time == ref[k].time;
+    }
+    ASSERT_EQ(fast.size(), ref.size());
+    ASSERT_GE(ref.size(), minCollisions);
+    EXPECT_EQ(exact, ref.size()) << "times bit-identical";
+}
+
+TEST(EdmEngine, MatchesReference2DPeriodicRoughElastic) {
+    GasSpec g;
+    g.n = 50;
+    g.phi = 0.35;
+    g.polydisperse = true;
+    g.spin = 1;
+    g.seed = 3;
+    // Elastic and perfectly rough (a dissipative gas slows down too much for a long comparison)
+    EdmSettings s;
+    s.tcModel = false;
+    s.tangential = EdmSettings::Tangential::Constant;
+    compareWithReference<2>(makeGas<2>(g, edmContact(1.0, 0.0, 1.0)), s, 10000);
+}
+
+TEST(EdmEngine, MatchesReference3DPeriodicRoughElastic) {
+    GasSpec g;
+    g.n = 50;
+    g.phi = 0.2;
+    g.polydisperse = true;
+    g.spin = 1;
+    g.seed = 4;
+    EdmSettings s;
+    s.tcModel = false;
+    s.tangential = EdmSettings::Tangential::Constant;
+    compareWithReference<3>(makeGas<3>(g, edmContact(1.0, 0.0, 1.0)), s, 10000);
+}
+
+TEST(EdmEngine, MatchesReference2DWalledGravity) {
+    GasSpec g;
+    g.n = 50;
+    g.phi = 0.25;
+    g.polydisperse = true;
+    g.periodic = false;
+    g.gravity = 1.0;
+    g.speed = 2;
+    g.seed = 5;
+    EdmSettings s;
+    s.tcTime = 1e-3;
+    compareWithReference<2>(makeGas<2>(g, edmContact(0.8, 0.4, 0.6)), s, 10000);
+}
+
+TEST(EdmEngine, MatchesReference3DMixedGravityFrozen) {
+    GasSpec g;
+    g.n = 50;
+    g.phi = 0.2;
+    g.polydisperse = true;
+    g.periodic = true;
+    g.gravity = 1.0;
+    g.speed = 2;
+    g.seed = 6;
+    World<3> w = makeGas<3>(g, edmContact(0.9, 0.3, 0.5));
+    // periodic in x, y; a floor and a ceiling along z; the lowest layer of particles frozen as obstacles
+    w.domain.periodic[2] = false;
+    const double L = w.domain.hi[2];
+    w.walls.push_back({Vec<3>::zero(), Vec<3>{{0, 0, 1}}, Vec<3>::zero(), 0});
+    w.walls.push_back({Vec<3>::filled(L), Vec<3>{{0, 0, -1}}, Vec<3>::zero(), 0});
+    for (int i = 0; i < 9; ++i) {
+        w.particles.flags[i] |= kFrozen;
+        w.particles.invMass[i] = 0;
+        w.particles.invInertia[i] = 0;
+        w.particles.v[i] = Vec<3>::zero();
+    }
+    EdmSettings s;
+    s.tcTime = 1e-3;
+    compareWithReference<3>(w, s, 10000);
+}
+
+// ---- conservation ----
+
+template <int D>
+void elasticGasEnergy(bool rough, std::uint64_t minCollisions) {
+    GasSpec g;
+    g.n = D == 3 ? 1000 : 900;
+    g.phi = D == 3 ? 0.25 : 0.5;
+    g.polydisperse = true;
+    g.spin = rough ? 1 : 0;
+    EdmSettings s;
+    s.tangential = EdmSettings::Tangential::Constant;
+    World<D> w = makeGas<D>(g, edmContact(1.0, 0.0, rough ? 1.0 : -1.0));
+    EdmEngine<D> eng(w, s);
+    const double e0 = kineticEnergyEdm(w.particles);
+    double t = 0;
+    while (eng.collisions() < minCollisions) {
+        t += 1.0;
+        eng.advanceTo(t);
+        EXPECT_NEAR(kineticEnergyEdm(w.particles), e0, 1e-12 * e0) << "t = " << t;
+    }
+    ::testing::Test::RecordProperty("relative_energy_error", std::to_string(kineticEnergyEdm(w.particles) / e0 - 1));
+    EXPECT_LT(testing::maxOverlapRatio(w), 1e-9);
+}
+
+TEST(EdmEngine, ElasticSmoothGasConservesEnergy3D) { elasticGasEnergy<3>(false, 100000); }
+TEST(EdmEngine, ElasticRoughGasConservesEnergy2D) { elasticGasEnergy<2>(true, 100000); }
+
+TEST(EdmEngine, MomentumConservedInPeriodicGas) {
+    GasSpec g;
+    g.n = 300;
+    g.phi = 0.2;
+    g.polydisperse = true;
+    g.spin = 1;
+    World<3> w = makeGas<3>(g, edmContact(0.7, 0.5, 0.3));
+    EdmSettings s;
+    s.tcModel = false;
+    double scale = 0;  // of the initial state: the gas cools
+    for (std::size_t i = 0; i < w.particles.size(); ++i) scale += w.particles.mass[i] * norm(w.particles.v[i]);
+    EdmEngine<3> eng(w, s);
+    for (double t = 1; eng.collisions() < 20000; t *= 1.5) eng.advanceTo(t);
+    Vec<3> pm = Vec<3>::zero();
+    for (std::size_t i = 0; i < w.particles.size(); ++i) pm += w.particles.v[i] * w.particles.mass[i];
+    EXPECT_LT(norm(pm), 1e-12 * scale);
+}
+
+// ---- geometry: periodic images, moving walls, frozen particles ----
+
+TEST(EdmEngine, PeriodicWrapRecordsImages) {
+    World<2> w;
+    w.contact = edmContact(1.0);
+    w.domain.lo = Vec<2>::zero();
+    w.domain.hi = Vec<2>{{10, 10}};
+    w.domain.periodic = {true, true};
+    w.particles.add(Vec<2>{{1, 1}}, Vec<2>{{3.3, -1.7}}, Ang<2>{{0.5}}, 0.5, 1.0, 0, 0);
+    EdmEngine<2> eng(w, EdmSettings{});
+    for (int k = 1; k <= 20; ++k) {
+        eng.advanceTo(k * 1.0);
+        const Vec<2> unwrapped = w.particles.x[0] + w.particles.image[0];
+        EXPECT_NEAR(unwrapped[0], 1 + 3.3 * k, 1e-12);
+        EXPECT_NEAR(unwrapped[1], 1 - 1.7 * k, 1e-12);
+        EXPECT_GE(w.particles.x[0][0], 0);
+        EXPECT_LT(w.particles.x[0][0], 10);
+        EXPECT_NEAR(w.particles.angle[0][0], 0.5 * k, 1e-12);  // free rotation
+    }
+    EXPECT_GT(eng.stats().cellCrossings, 50u);
+    EXPECT_EQ(eng.collisions(), 0u);
+}
+
+TEST(EdmEngine, PeriodicImagesCollide) {
+    // two particles that meet only through the periodic boundary
+    World<3> w;
+    w.contact = edmContact(1.0);
+    w.domain.lo = Vec<3>::zero();
+    w.domain.hi = Vec<3>::filled(4);
+    w.domain.periodic = {true, true, true};
+    w.particles.add(Vec<3>{{0.6, 2, 2}}, Vec<3>{{-1, 0, 0}}, Ang<3>::zero(), 0.5, 1.0, 0, 0);
+    w.particles.add(Vec<3>{{3.4, 2, 2}}, Vec<3>{{1, 0, 0}}, Ang<3>::zero(), 0.5, 1.0, 0, 1);
+    EdmSettings s;
+    EdmEngine<3> eng(w, s);
+    eng.advanceTo(0.25);
+    // gap through the boundary: 0.6 + (4 - 3.4) - 1 = 0.2, closing at 2 m/s -> contact at t = 0.1, then reversed
+    EXPECT_EQ(eng.collisions(), 1u);
+    EXPECT_NEAR(w.particles.v[0][0], 1, 1e-14);
+    EXPECT_NEAR(w.particles.v[1][0], -1, 1e-14);
+    EXPECT_NEAR(w.particles.x[0][0], 0.6 - 0.1 + 0.15, 1e-12);
+    // virial r_ij . dp_i = sigma m_eff (1+e) |g_n| = 1 * 0.5 m * 2 * 2 (PHYSICS.md E.2)
+    const double m = w.particles.mass[0];
+    EXPECT_NEAR(eng.takeCollisionVirial(), 2 * m, 1e-12 * m);
+    EXPECT_EQ(eng.takeCollisionVirial(), 0.0);
+}
+
+TEST(EdmEngine, MovingWallPushesParticle) {
+    World<3> w;
+    w.contact = edmContact(1.0);
+    w.domain.lo = Vec<3>::filled(-5);
+    w.domain.hi = Vec<3>::filled(5);
+    // piston at x = 1 moving with -1 m/s, normal -x; particle at rest at x = 0.5, radius 0.1: contact at t = 0.4
+    w.walls.push_back({Vec<3>{{1, 0, 0}}, Vec<3>{{-1, 0, 0}}, Vec<3>{{-1, 0, 0}}, 0});
+    w.particles.add(Vec<3>::zero() + Vec<3>{{0.5, 0, 0}}, Vec<3>::zero(), Ang<3>::zero(), 0.1, 1.0, 0, 0);
+    EdmEngine<3> eng(w, EdmSettings{});
+    eng.advanceTo(1.0);
+    EXPECT_EQ(eng.collisions(), 1u);
+    EXPECT_NEAR(w.particles.v[0][0], -2, 1e-14);  // elastic reflection off a wall moving at -1
+    EXPECT_NEAR(w.particles.x[0][0], 0.5 - 2 * 0.6, 1e-12);
+}
+
+TEST(EdmEngine, FrozenParticlesNeverMove) {
+    GasSpec g;
+    g.n = 125;
+    g.phi = 0.3;
+    g.periodic = false;
+    g.gravity = 2;
+    World<3> w = makeGas<3>(g, edmContact(0.7, 0.5, 0.5));
+    std::vector<Vec<3>> x0;
+    for (int i = 0; i < 25; ++i) {  // the lowest lattice layer
+        w.particles.flags[i] |= kFrozen;
+        w.particles.invMass[i] = 0;
+        w.particles.invInertia[i] = 0;
+        x0.push_back(w.particles.x[i]);
+    }
+    EdmSettings s;
+    s.tcTime = 1e-3;
+    EdmEngine<3> eng(w, s);
+    eng.advanceTo(3.0);
+    for (int i = 0; i < 25; ++i) EXPECT_TRUE(w.particles.x[i] == x0[i]);
+    EXPECT_LT(testing::maxOverlapRatio(w), 1e-9);
+    EXPECT_LT(testing::maxWallPenetration(w), 1e-9);
+    EXPECT_GT(eng.collisions(), 1000u);
+}
+
+// ---- inelastic collapse: the TC model and the guard ----
+
+World<3> bouncingBall(double e) {
+    World<3> w;
+    w.contact = edmContact(e, 0.5, 0.5);
+    w.domain.lo = Vec<3>::filled(-1);
+    w.domain.hi = Vec<3>::filled(1);
+    w.domain.gravity = Vec<3>{{0, 0, -9.81}};
+    w.walls.push_back({Vec<3>{{0, 0, -1}}, Vec<3>{{0, 0, 1}}, Vec<3>::zero(), 0});
+    w.particles.add(Vec<3>{{0, 0, 0}}, Vec<3>{{0.3, 0, 0}}, Ang<3>::zero(), 0.05, 1000, 0, 0);
+    return w;
+}
+
+TEST(EdmEngine, CollapseWithoutTcModelIsReported) {
+    World<3> w = bouncingBall(0.5);
+    EdmSettings s;
+    s.tcModel = false;
+    s.maxEventRate = 1e5;
+    EdmEngine<3> eng(w, s);
+    EXPECT_THROW(eng.advanceTo(10.0), SimulationError);
+}
+
+TEST(EdmEngine, CollapseUnderDefaultBoundIsReported) {
+    World<3> w = bouncingBall(0.5);
+    EdmSettings s;
+    s.tcModel = false;  // no TC time: the default bound 10^4 u / d_min catches the micro-bouncing
+    EdmEngine<3> eng(w, s);
+    EXPECT_THROW(eng.advanceTo(10.0), SimulationError);
+}
+
+TEST(EdmEngine, TcModelLetsBallSettle) {
+    World<3> w = bouncingBall(0.5);
+    EdmSettings s;
+    s.tcTime = 1e-4;
+    EdmEngine<3> eng(w, s);
+    eng.advanceTo(10.0);
+    // resting: hops of height g (2 tc)^2 / 8 above the floor, sliding stopped by friction
+    const double h = w.particles.x[0][2] + 1 - 0.05;
+    EXPECT_GE(h, -1e-12);
+    EXPECT_LT(h, 9.81 * 4e-8 / 2);
+    EXPECT_LT(std::abs(w.particles.v[0][2]), 9.81 * 2e-4);
+    // rolling without sliding: g_t = v_x - a w_y -> 0 through the sticking collisions (beta0 = 0.5)
+    EXPECT_LT(std::abs(w.particles.v[0][0] - 0.05 * w.particles.w[0][1]), 1e-6);
+    EXPECT_NEAR(w.particles.v[0][0], 0.3 * 5 / 7, 0.02);
+    EXPECT_GT(eng.stats().restHops, 1000u);
+    EXPECT_LT(eng.events(), 10.0 / 1e-4 * 2);  // about one hop per 2 tc
+}
+
+TEST(EdmEngine, RejectsBadSettings) {
+    World<3> w = bouncingBall(0.5);
+    EdmSettings s;
+    s.cellSize = 0.05;  // below the diameter 0.1
+    EXPECT_THROW({ EdmEngine<3> e(w, s); }, std::invalid_argument);
+    World<3> empty;
+    EXPECT_THROW({ EdmEngine<3> e(empty, EdmSettings{}); }, std::invalid_argument);  // no contact table
+}
+
+}  // namespace
+}  // namespace haet
