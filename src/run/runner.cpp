@@ -17,6 +17,7 @@
 #include "io/png.hpp"
 #include "io/series.hpp"
 #include "io/vtk.hpp"
+#include "edm/engine.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
 
@@ -100,6 +101,36 @@ private:
 };
 
 template <int D>
+class EdmDriver final : public Driver<D> {
+public:
+    EdmDriver(World<D>& w, const EdmSettings& s) : eng_(w, s) {}
+    const char* method() const override { return "edm"; }
+    void advanceTo(double t) override { eng_.advanceTo(t); }
+    double timeTolerance() const override { return 1e-12; }
+    std::uint64_t steps() const override { return 0; }
+    std::size_t contacts() const override { return 0; }
+    double maxOverlapRatio() const override { return 0; }
+    double elasticEnergy() const override { return 0; }
+    /// Collision virial (PHYSICS.md E.2): sum of r_ij . dp_i over the window, divided by its length.
+    double virial(double window) override {
+        const double v = eng_.takeCollisionVirial();
+        return window > 0 ? v / window : 0.0;
+    }
+    std::vector<std::string> extraColumns() const override { return {"events", "collisions"}; }
+    std::vector<std::optional<double>> extraRow() const override {
+        return {double(eng_.events()), double(eng_.collisions())};
+    }
+    void describe(JsonObject& j) const override {
+        j.add("events", eng_.events());
+        j.add("collisions", eng_.collisions());
+        j.add("tc_time", eng_.tcTime());
+    }
+
+private:
+    EdmEngine<D> eng_;
+};
+
+template <int D>
 std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
     switch (sc.method) {
         case Method::Tdm: {
@@ -107,10 +138,18 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
             return std::make_unique<TdmDriver<D>>(world, ts, note);
         }
-        case Method::Edm:
+        case Method::Edm: {
+            EdmSettings es;
+            es.cellSize = sc.edm.cellSize.value_or(0.0);
+            es.tangential = sc.edm.tangential == EdmTangential::Constant ? EdmSettings::Tangential::Constant
+                                                                          : EdmSettings::Tangential::Walton;
+            es.tcModel = sc.edm.tcModel;
+            es.tcTime = sc.edm.tcTime.value_or(0.0);
+            return std::make_unique<EdmDriver<D>>(world, es);
+        }
         case Method::Haet: break;
     }
-    throw ScenarioError({sc.path, 0}, "method", "only \"tdm\" is available in this version");
+    throw ScenarioError({sc.path, 0}, "method", "\"haet\" is not available in this version (use \"tdm\" or \"edm\")");
 }
 
 template <int D>
@@ -395,9 +434,31 @@ RunStatus runScenario(const Scenario& sc, const RunOptions& opt, std::ostream& l
     return sc.dimension == 2 ? runWorld<2>(sc, opt, log) : runWorld<3>(sc, opt, log);
 }
 
+template <int D>
+void describeEdm(const Scenario& sc, std::ostream& out) {
+    World<D> world = buildWorld<D>(sc);
+    const double tc = sc.edm.tcTime.value_or(world.contact.contactTime);
+    out << fmt::format("scenario   {} ({})\n", sc.name, sc.path);
+    out << fmt::format("method     edm (event-driven), {}D, tangential {}\n", D,
+                       sc.edm.tangential == EdmTangential::Constant ? "constant beta" : "Walton's rule");
+    out << fmt::format("particles  {}, {} materials, {} walls\n", world.particles.size(), sc.materials.size(),
+                       world.walls.size());
+    out << fmt::format("collapse   TC model {} (tc_time = {:.4g} s)\n", sc.edm.tcModel ? "on" : "off", tc);
+    for (std::size_t a = 0; a < sc.materials.size(); ++a)
+        out << fmt::format("material   {}: restitution {:.5f} (the soft law's, incl. contact-end rule)\n",
+                           sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+}
+
 void describeScenario(const Scenario& sc, std::ostream& out) {
+    if (sc.method == Method::Edm) {
+        if (sc.dimension == 2)
+            describeEdm<2>(sc, out);
+        else
+            describeEdm<3>(sc, out);
+        return;
+    }
     if (sc.method != Method::Tdm)
-        throw ScenarioError({sc.path, 0}, "method", "only \"tdm\" is available in this version");
+        throw ScenarioError({sc.path, 0}, "method", "\"haet\" is not available in this version (use \"tdm\" or \"edm\")");
     if (sc.dimension == 2)
         describeTdm<2>(sc, out);
     else
