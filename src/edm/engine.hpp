@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "edm/collision.hpp"
@@ -40,8 +41,8 @@ struct EdmSettings {
 template <int D>
 struct EdmCollision {
     double time = 0;            ///< [s]
-    std::uint32_t i = 0;        ///< particle index
-    std::uint32_t partner = 0;  ///< particle index, or wall index when wall is true
+    std::uint32_t i = 0;        ///< World index of the particle (of a pair: the lower index, unless frozen)
+    std::uint32_t partner = 0;  ///< World index of the other particle, or the wall index when wall is true
     bool wall = false;
     bool elastic = false;  ///< made elastic by the TC model
     bool restHop = false;  ///< normal speed raised to the rest-hop speed (wall or frozen partner)
@@ -92,7 +93,7 @@ public:
     const EdmSettings& settings() const { return s_; }
     double tcTime() const { return tc_; }  ///< the TC time in use [s] (0: TC model off)
     double cellSize() const;               ///< smallest cell edge of the grid [m]
-    double nextEventTime() const;          ///< time of the next pending event [s]
+    double nextEventTime() const;          ///< time of the next pending event [s] (reference mode: infinity)
     std::size_t memoryBytes() const;       ///< heap memory of the engine's own arrays [bytes]
 
 private:

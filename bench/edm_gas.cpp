@@ -1,0 +1,66 @@
+// Collisions per second of the event-driven engine on elastic smooth hard-sphere (disk) gases, one thread:
+// 3D at phi = 0.1, 0.3, 0.45 and 2D at phi = 0.3, N = 10^5 (goal: >= 3 10^5 collisions/s for 3D phi = 0.3).
+// Start: simple cubic (square) lattice with Gaussian velocities, then ~3 collisions per particle to equilibrate
+// (not timed). Each iteration advances the gas by about N collisions. Counters: collisions per second, events
+// per collision, bytes per particle (engine's own arrays, and with the shared particle store).
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "../tests/test_edm_util.hpp"
+
+namespace {
+
+// Elements in use: capacity left over by push_back growth is never touched, so never resident.
+template <class T>
+std::size_t capacityBytes(const std::vector<T>& v) {
+    return v.size() * sizeof(T);
+}
+
+template <int D>
+std::size_t storeBytes(const haet::Particles<D>& p) {
+    return capacityBytes(p.x) + capacityBytes(p.v) + capacityBytes(p.w) + capacityBytes(p.f) + capacityBytes(p.torque) +
+           capacityBytes(p.radius) + capacityBytes(p.invMass) + capacityBytes(p.invInertia) +
+           capacityBytes(p.material) + capacityBytes(p.flags) + capacityBytes(p.mass) + capacityBytes(p.angle) +
+           capacityBytes(p.id) + capacityBytes(p.image);
+}
+
+template <int D>
+void gas(benchmark::State& state) {
+    const int n = static_cast<int>(state.range(0));
+    const double phi = static_cast<double>(state.range(1)) / 100.0;
+    haet::testing::GasSpec g;
+    g.n = n;
+    g.phi = phi;
+    g.seed = 5;
+    haet::World<D> w = haet::testing::makeGas<D>(g, haet::testing::edmContact(1.0));
+    haet::EdmSettings s;
+    s.tcModel = false;
+    haet::EdmEngine<D> eng(w, s);
+    double t = 0;
+    while (eng.collisions() < 3.0 * n) eng.advanceTo(t += 0.05);
+    // time per N collisions, from the equilibration rate
+    const double dt = t * n / static_cast<double>(eng.collisions());
+    const std::uint64_t c0 = eng.collisions(), e0 = eng.events();
+    for (auto _ : state) eng.advanceTo(t += dt);
+    const double coll = static_cast<double>(eng.collisions() - c0);
+    state.counters["collisions_per_s"] = benchmark::Counter(coll, benchmark::Counter::kIsRate);
+    state.counters["events_per_collision"] = static_cast<double>(eng.events() - e0) / coll;
+    state.counters["engine_bytes_per_particle"] = static_cast<double>(eng.memoryBytes()) / n;
+    state.counters["total_bytes_per_particle"] = static_cast<double>(eng.memoryBytes() + storeBytes(w.particles)) / n;
+}
+
+void gas3(benchmark::State& s) { gas<3>(s); }
+void gas2(benchmark::State& s) { gas<2>(s); }
+
+BENCHMARK(gas3)
+    ->Name("EdmGas3D")
+    ->Args({100000, 10})
+    ->Args({100000, 30})
+    ->Args({100000, 45})
+    ->Iterations(4)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(gas2)->Name("EdmGas2D")->Args({100000, 30})->Iterations(4)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
