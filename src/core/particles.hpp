@@ -1,6 +1,7 @@
 #pragma once
 // The one particle store shared by every engine: structure-of-arrays, ordered for the force loop.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/vec.hpp"
@@ -35,7 +36,12 @@ struct Particles {
     std::vector<std::uint64_t> id;  ///< stable user-visible id (survives reordering)
     std::vector<Vec<D>> image;    ///< accumulated periodic wraps, for unwrapped positions [m]
 
+    /// Particles [0, tdmCount()) are integrated by the time-driven engine. In a hybrid run the rest belong to the
+    /// event-driven engine (PHYSICS.md A); in a pure run one engine owns them all (the default: every particle).
+    std::size_t nTdm = static_cast<std::size_t>(-1);
+
     std::size_t size() const { return x.size(); }
+    std::size_t tdmCount() const { return nTdm < x.size() ? nTdm : x.size(); }
 
     /// Appends one particle of given density [kg/m^D-volume]; mass from radius and density.
     std::size_t add(const Vec<D>& pos, const Vec<D>& vel, const Ang<D>& spin, double r, double density,
@@ -68,7 +74,16 @@ struct Particles {
     double inertia(std::size_t i) const { return kInertiaFactor<D> * mass[i] * radius[i] * radius[i]; }
     bool frozen(std::size_t i) const { return flags[i] & kFrozen; }
 
-    /// Applies a permutation: new index k holds old particle order[k]. Used for spatial sorting.
+    /// Exchanges particles i and j (all fields).
+    void swapEntries(std::size_t i, std::size_t j) {
+        if (i == j) return;
+        auto sw = [&](auto& arr) { std::swap(arr[i], arr[j]); };
+        sw(x); sw(v); sw(w); sw(f); sw(torque); sw(radius); sw(invMass); sw(invInertia); sw(material); sw(flags);
+        sw(mass); sw(angle); sw(id); sw(image);
+    }
+
+    /// Applies a permutation: new index k holds old particle order[k]. Used for spatial sorting. A shorter order
+    /// permutes the first order.size() particles only.
     void permute(const std::vector<std::uint32_t>& order) {
         auto apply = [&](auto& arr) {
             auto tmp = arr;

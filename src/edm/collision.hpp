@@ -23,6 +23,15 @@ struct CollisionBody {
     double invInertia = 0;  ///< 1/I [1/(kg m^2)]; 0 = infinite inertia
 };
 
+/// Kinetic energy of a body, translation and rotation [J]; 0 for an infinitely heavy one.
+template <int D>
+inline double kineticEnergy(const CollisionBody<D>& b) {
+    double e = 0;
+    if (b.invMass > 0) e += 0.5 * norm2(b.v) / b.invMass;
+    if (b.invInertia > 0) e += 0.5 * norm2(b.w) / b.invInertia;
+    return e;
+}
+
 /// How beta is chosen (PHYSICS.md C.2).
 enum class BetaRule {
     Walton,    ///< beta = min(beta0, -1 + mu (1+e) (m_eff/m_t) |g_n|/|g_t|): sticking or Coulomb sliding

@@ -48,22 +48,24 @@ template <int D>
 void EdmEngine<D>::reset() {
     Particles<D>& p = w_.particles;
     const std::size_t n = p.size();
+    const std::size_t first = std::min(s_.firstParticle, n);
     if (n >= (1u << kTypeShift)) throw std::invalid_argument("event-driven engine: too many particles");
     rmax_ = 0;
     nMoving_ = 0;
+    // Every particle sizes the grid (those of another engine may join later).
     for (std::size_t i = 0; i < n; ++i) {
         if (!(p.radius[i] > 0)) throw std::invalid_argument("event-driven engine: particle with radius <= 0");
         if (p.material[i] >= w_.contact.nMaterials)
             throw std::invalid_argument("event-driven engine: particle material outside the contact table");
         rmax_ = std::max(rmax_, p.radius[i]);
-        if (!p.frozen(i)) ++nMoving_;
+        if (i >= first && !p.frozen(i)) ++nMoving_;
     }
     for (int k = 0; k < D; ++k)
         if (w_.domain.periodic[k] && boxLen_[k] < 4 * rmax_)
             throw std::invalid_argument("event-driven engine: periodic axis " + std::to_string(k) +
                                         " is shorter than two particle diameters");
     // Periodic positions into the box (frozen particles too: they never move afterwards).
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = first; i < n; ++i) {
         for (int k = 0; k < D; ++k) {
             if (!w_.domain.periodic[k]) continue;
             double& x = p.x[i][k];
@@ -82,7 +84,7 @@ void EdmEngine<D>::reset() {
         maxRate_ = 1000.0 / tcRef_;
     } else {
         double dmin = kNever, v2 = 0;
-        for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t i = first; i < n; ++i) {
             dmin = std::min(dmin, 2 * p.radius[i]);
             if (!p.frozen(i)) v2 += norm2(p.v[i]);
         }
@@ -100,14 +102,23 @@ void EdmEngine<D>::reset() {
     hot_.resize(n);
     link_.assign(n, Link{kNil, 0, Shift{}});
     rec_.assign(n, Rec{Candidate{}, -std::numeric_limits<double>::infinity(), kNone << kTypeShift, 0, kNil, 0});
+    const std::uint32_t freeCell = static_cast<std::uint32_t>(head_.size());
     for (std::uint32_t i = 0; i < n; ++i) {
         const bool fz = p.frozen(i);
+        if (i < first) {  // a free slot, for a particle that joins later
+            hot_[i] = Hot{p.x[i], kNever, Vec<D>::zero(), p.radius[i]};
+            rec_[i].idx = kNil;
+            rec_[i].cell = freeCell;
+            continue;
+        }
         hot_[i] = Hot{p.x[i], fz ? kNever : w_.time, fz ? Vec<D>::zero() : p.v[i], p.radius[i]};
         rec_[i].idx = i;
         rec_[i].cell = cellOf(p.x[i]);
     }
+    nLive_ = n - first;
     queue_.reset(n);
-    resort();  // also links the cells
+    resort();  // also links the cells, numbers slotOf_ and free_
+    if (zoned_) attachZones(zone_);
     if (s_.reference) return;
     for (std::uint32_t s = 0; s < n; ++s)
         if (!frozen(s)) predict(s, w_.time);
@@ -192,7 +203,8 @@ template <int D>
 void EdmEngine<D>::linkCells() {
     std::fill(head_.begin(), head_.end(), kNil);
     // Inserted from the last slot down, so each cell's list runs in increasing slot order.
-    for (std::uint32_t s = static_cast<std::uint32_t>(hot_.size()); s-- > 0;) insertCell(s, rec_[s].cell);
+    for (std::uint32_t s = static_cast<std::uint32_t>(hot_.size()); s-- > 0;)
+        if (rec_[s].idx != kNil) insertCell(s, rec_[s].cell);
 }
 
 // Reorders the slots cell by cell (stable in the current order): neighbours in space become neighbours in memory.
@@ -200,7 +212,7 @@ void EdmEngine<D>::linkCells() {
 template <int D>
 void EdmEngine<D>::resort() {
     const std::size_t n = hot_.size();
-    std::vector<std::uint32_t> start(head_.size() + 1, 0);
+    std::vector<std::uint32_t> start(head_.size() + 2, 0);  // the last bucket: free slots
     for (std::size_t s = 0; s < n; ++s) ++start[rec_[s].cell + 1];
     for (std::size_t c = 0; c + 1 < start.size(); ++c) start[c + 1] += start[c];
     std::vector<std::uint32_t> order(n), newSlot(n);  // order[new] = old
@@ -228,6 +240,14 @@ void EdmEngine<D>::resort() {
     }
     queue_.build(times);
     linkCells();
+    slotOf_.assign(w_.particles.size(), kNil);
+    free_.clear();
+    for (std::uint32_t k = static_cast<std::uint32_t>(n); k-- > 0;) {
+        if (rec_[k].idx == kNil)
+            free_.push_back(k);
+        else
+            slotOf_[rec_[k].idx] = k;
+    }
     sortedAt_ = events_;
 }
 
@@ -509,8 +529,18 @@ void EdmEngine<D>::crossCell(std::uint32_t s, int axis, bool up) {
     }
     const std::uint32_t newCell =
         rec_[s].cell + (static_cast<std::uint32_t>(cn) - static_cast<std::uint32_t>(c)) * stride_[axis];
+    const std::uint32_t oldCell = rec_[s].cell;
     removeCell(s);
     insertCell(s, newCell);
+    if (zoned_) {
+        const std::uint32_t za = zoneOfCell(oldCell), zb = zoneOfCell(newCell);
+        if (za != zb) {
+            const double vol = Particles<D>::volumeOf(hot_[s].r);
+            zoneVolume_[za] -= vol;
+            zoneVolume_[zb] += vol;
+        }
+        if ((*zone_.guard)[newCell]) guardEntries_.push_back(rec_[s].idx);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -603,7 +633,13 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
         P = n * ((uRest - gn) / (b1.invMass + b2.invMass));
         hop = true;
     }
+    const double before = kineticEnergy(b1) + kineticEnergy(b2);
     applyImpulse(b1, b2, n, P);
+    stats_.dissipated += before - kineticEnergy(b1) - kineticEnergy(b2);
+    if (elastic && zoned_ && zone_.handoverOnTc) {
+        tcHandovers_.push_back(i);
+        if (!fb) tcHandovers_.push_back(j);
+    }
     hot_[a].v = b1.v;
     p.w[i] = b1.w;
     ++link_[a].count;
@@ -654,7 +690,10 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
         P = n * ((uRest - gn) / b1.invMass);
         hop = true;
     }
+    const double before = kineticEnergy(b1);
     applyImpulse(b1, b2, n, P);
+    stats_.dissipated += before - kineticEnergy(b1);
+    if (elastic && zoned_ && zone_.handoverOnTc) tcHandovers_.push_back(i);
     hot_[s].v = b1.v;
     p.w[i] = b1.w;
     ++link_[s].count;
@@ -731,34 +770,37 @@ void EdmEngine<D>::processNext() {
 }
 
 template <int D>
-void EdmEngine<D>::synchronise(double t) {
+void EdmEngine<D>::syncSlot(std::uint32_t s, double t) {
     Particles<D>& p = w_.particles;
     const Domain<D>& dom = w_.domain;
-    for (std::uint32_t s = 0; s < hot_.size(); ++s) {
-        if (frozen(s)) continue;
-        advance(s, t);
-        Hot& h = hot_[s];
-        const std::uint32_t i = rec_[s].idx;
-        for (int k = 0; k < D; ++k) {
-            if (!dom.periodic[k]) continue;
-            double& x = h.x[k];
-            const double lo = dom.lo[k], L = boxLen_[k];
-            if (x >= lo && x < lo + L) continue;
-            const double sh = std::floor((x - lo) / L);
-            x -= sh * L;
-            p.image[i][k] += sh * L;
-            // The box-frame position x - wrap L is unchanged, so the cell and the pending events stay valid.
-            link_[s].wrap[k] -= static_cast<std::int32_t>(sh);
-        }
-        p.x[i] = h.x;
-        p.v[i] = h.v;
-        if (!std::isfinite(norm2(h.x) + norm2(h.v) + norm2(p.w[i]))) {
-            std::ostringstream msg;
-            msg << "event-driven engine: particle " << p.id[i] << " (index " << i
-                << ") has a non-finite state at t = " << t << " s";
-            throw SimulationError(msg.str());
-        }
+    advance(s, t);
+    Hot& h = hot_[s];
+    const std::uint32_t i = rec_[s].idx;
+    for (int k = 0; k < D; ++k) {
+        if (!dom.periodic[k]) continue;
+        double& x = h.x[k];
+        const double lo = dom.lo[k], L = boxLen_[k];
+        if (x >= lo && x < lo + L) continue;
+        const double sh = std::floor((x - lo) / L);
+        x -= sh * L;
+        p.image[i][k] += sh * L;
+        // The box-frame position x - wrap L is unchanged, so the cell and the pending events stay valid.
+        link_[s].wrap[k] -= static_cast<std::int32_t>(sh);
     }
+    p.x[i] = h.x;
+    p.v[i] = h.v;
+    if (!std::isfinite(norm2(h.x) + norm2(h.v) + norm2(p.w[i]))) {
+        std::ostringstream msg;
+        msg << "event-driven engine: particle " << p.id[i] << " (index " << i << ") has a non-finite state at t = " << t
+            << " s";
+        throw SimulationError(msg.str());
+    }
+}
+
+template <int D>
+void EdmEngine<D>::synchronise(double t) {
+    for (std::uint32_t s = 0; s < hot_.size(); ++s)
+        if (!frozen(s)) syncSlot(s, t);
     w_.time = t;
 }
 
@@ -829,12 +871,161 @@ void EdmEngine<D>::advanceTo(double t) {
     if (t < w_.time) throw std::invalid_argument("event-driven engine: advanceTo into the past");
     if (s_.reference) {
         advanceReference(t);
-    } else {
-        while (queue_.size() > 0 && queue_.topTime() < t) processNext();
+        synchronise(t);
+        return;
     }
+    advanceEvents(t);
     synchronise(t);
+}
+
+template <int D>
+void EdmEngine<D>::advanceEvents(double t) {
+    if (s_.reference) throw std::logic_error("event-driven engine: advanceEvents in reference mode");
+    while (queue_.size() > 0 && queue_.topTime() < t) processNext();
     // Particles diffuse away from their sorted neighbours; re-sort after ~20 events per particle.
-    if (!s_.reference && events_ - sortedAt_ > 20 * static_cast<std::uint64_t>(hot_.size())) resort();
+    if (events_ - sortedAt_ > 20 * static_cast<std::uint64_t>(std::max<std::size_t>(nLive_, 1))) resort();
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// particles joining and leaving (hybrid runs)
+
+template <int D>
+void EdmEngine<D>::remove(std::size_t i, double t) {
+    if (!owns(i)) throw std::logic_error("event-driven engine: remove of a particle it does not own");
+    const std::uint32_t s = slotOf_[i];
+    const bool fz = frozen(s);
+    if (!fz) syncSlot(s, t);
+    removeCell(s);
+    if (zoned_) zoneVolume_[zoneOfCell(rec_[s].cell)] -= Particles<D>::volumeOf(hot_[s].r);
+    ++link_[s].count;  // events of others that name s are stale now
+    hot_[s].t = kNever;
+    hot_[s].v = Vec<D>::zero();
+    rec_[s].idx = kNil;
+    rec_[s].cell = static_cast<std::uint32_t>(head_.size());
+    rec_[s].evCode = kNone << kTypeShift;
+    rec_[s].coll = Candidate{};
+    queue_.update(s, kNever);
+    slotOf_[i] = kNil;
+    free_.push_back(s);
+    --nLive_;
+    if (!fz) --nMoving_;
+}
+
+template <int D>
+void EdmEngine<D>::add(std::size_t i, double t) {
+    Particles<D>& p = w_.particles;
+    if (owns(i) || i >= p.size()) throw std::logic_error("event-driven engine: add of an owned or unknown particle");
+    if (free_.empty()) throw std::logic_error("event-driven engine: no free slot");
+    if (p.radius[i] > rmax_ * (1 + 1e-12)) throw std::logic_error("event-driven engine: particle larger than the grid");
+    const std::uint32_t s = free_.back();
+    free_.pop_back();
+    for (int k = 0; k < D; ++k) {
+        if (!w_.domain.periodic[k]) continue;
+        double& x = p.x[i][k];
+        const double lo = w_.domain.lo[k], L = boxLen_[k];
+        if (x >= lo && x < lo + L) continue;
+        const double sh = std::floor((x - lo) / L);
+        x -= sh * L;
+        p.image[i][k] += sh * L;
+    }
+    const bool fz = p.frozen(i);
+    hot_[s] = Hot{p.x[i], fz ? kNever : t, fz ? Vec<D>::zero() : p.v[i], p.radius[i]};
+    link_[s].wrap = Shift{};
+    ++link_[s].count;
+    rec_[s].coll = Candidate{};
+    rec_[s].tLast = -std::numeric_limits<double>::infinity();
+    rec_[s].idx = static_cast<std::uint32_t>(i);
+    insertCell(s, cellOf(p.x[i]));
+    if (zoned_) zoneVolume_[zoneOfCell(rec_[s].cell)] += Particles<D>::volumeOf(hot_[s].r);
+    slotOf_[i] = s;
+    ++nLive_;
+    if (!fz) {
+        ++nMoving_;
+        predict(s, t);
+        return;
+    }
+    // A new obstacle: the moving particles around it re-predict (their events did not know it).
+    std::vector<std::uint32_t> around;
+    const std::uint32_t c = rec_[s].cell;
+    for (int code = 0; code < (D == 3 ? 27 : 9); ++code) {
+        std::uint32_t cell = 0;
+        bool ok = true;
+        int q = code;
+        for (int k = 0; k < D; ++k) {
+            int ck = static_cast<int>((c / stride_[k]) % static_cast<std::uint32_t>(nCell_[k])) + q % 3 - 1;
+            q /= 3;
+            if (ck < 0 || ck >= nCell_[k]) {
+                if (!w_.domain.periodic[k]) { ok = false; break; }
+                ck = (ck + nCell_[k]) % nCell_[k];
+            }
+            cell += static_cast<std::uint32_t>(ck) * stride_[k];
+        }
+        if (!ok) continue;
+        for (std::uint32_t j = head_[cell]; j != kNil; j = link_[j].next)
+            if (!frozen(j)) around.push_back(j);
+    }
+    std::sort(around.begin(), around.end());
+    around.erase(std::unique(around.begin(), around.end()), around.end());
+    for (const std::uint32_t j : around) predict(j, t);
+}
+
+template <int D>
+void EdmEngine<D>::swapIndices(std::size_t i, std::size_t j) {
+    if (i == j) return;
+    std::swap(slotOf_[i], slotOf_[j]);
+    if (slotOf_[i] != kNil) rec_[slotOf_[i]].idx = static_cast<std::uint32_t>(i);
+    if (slotOf_[j] != kNil) rec_[slotOf_[j]].idx = static_cast<std::uint32_t>(j);
+}
+
+template <int D>
+std::uint32_t EdmEngine<D>::zoneOfCell(std::uint32_t c) const {
+    std::uint32_t z = 0;
+    for (int k = 0; k < D; ++k) {
+        const std::uint32_t ck = (c / stride_[k]) % static_cast<std::uint32_t>(nCell_[k]);
+        z += zone_.zoneCoord[k][ck] * zone_.zoneStride[k];
+    }
+    return z;
+}
+
+template <int D>
+void EdmEngine<D>::attachZones(const EdmZoneLink<D>& link) {
+    if (link.guard == nullptr || link.guard->size() != head_.size())
+        throw std::invalid_argument("event-driven engine: the guard must have one entry per cell");
+    for (int k = 0; k < D; ++k)
+        if (link.zoneCoord[k].size() != static_cast<std::size_t>(nCell_[k]))
+            throw std::invalid_argument("event-driven engine: zone coordinates must cover every cell");
+    if (&link != &zone_) zone_ = link;
+    zoned_ = true;
+    zoneVolume_.assign(zone_.zones, 0.0);
+    for (std::uint32_t s = 0; s < hot_.size(); ++s)
+        if (rec_[s].idx != kNil) zoneVolume_[zoneOfCell(rec_[s].cell)] += Particles<D>::volumeOf(hot_[s].r);
+}
+
+template <int D>
+std::vector<std::uint32_t> EdmEngine<D>::takeGuardEntries() {
+    std::vector<std::uint32_t> out;
+    out.swap(guardEntries_);
+    return out;
+}
+
+template <int D>
+std::vector<std::uint32_t> EdmEngine<D>::takeTcHandovers() {
+    std::vector<std::uint32_t> out;
+    out.swap(tcHandovers_);
+    return out;
+}
+
+template <int D>
+Vec<D> EdmEngine<D>::positionAt(std::size_t i, double t) const {
+    const std::uint32_t s = slotOf_[i];
+    Vec<D> x = posAt(hot_[s], t);
+    for (int k = 0; k < D; ++k) {
+        if (!w_.domain.periodic[k]) continue;
+        x[k] -= link_[s].wrap[k] * boxLen_[k];
+        const double lo = w_.domain.lo[k], L = boxLen_[k];
+        x[k] -= std::floor((x[k] - lo) / L) * L;
+    }
+    return x;
 }
 
 template <int D>
@@ -852,7 +1043,8 @@ double EdmEngine<D>::nextEventTime() const {
 template <int D>
 std::size_t EdmEngine<D>::memoryBytes() const {
     auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-    return bytes(hot_) + bytes(link_) + bytes(rec_) + queue_.memoryBytes() + bytes(head_);
+    return bytes(hot_) + bytes(link_) + bytes(rec_) + queue_.memoryBytes() + bytes(head_) + bytes(slotOf_) +
+           bytes(free_) + bytes(zoneVolume_);
 }
 
 template class EdmEngine<2>;

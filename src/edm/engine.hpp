@@ -32,6 +32,9 @@ struct EdmSettings {
     /// loop). 0: 1000 / tcTime (also when the TC model is off); without any TC time 10^4 u / d_min, where u is
     /// the largest of the rms particle speed, sqrt(|g| d_min) and the fastest wall speed at the start.
     double maxEventRate = 0;
+    /// World index of the first particle this engine owns. Those before it belong to another engine (the
+    /// time-driven one of a hybrid run) and are invisible here; particles join and leave with add() and remove().
+    std::size_t firstParticle = 0;
     /// Reference twin: the next event by brute force (all pairs and all walls at every event, O(N^2) per event),
     /// no cells, no queue. For tests.
     bool reference = false;
@@ -49,6 +52,22 @@ struct EdmCollision {
     Vec<D> impulse;        ///< impulse on particle i [N s]
 };
 
+/// What a hybrid run asks of the event-driven engine (PHYSICS.md A.2-A.4): the volume of its particles per zone,
+/// kept current as they cross cells, and the particles that must leave it for the time-driven engine.
+template <int D>
+struct EdmZoneLink {
+    /// Per cell of the event grid: nonzero where an event-driven particle must not be (near time-driven ones).
+    /// Owned by the hybrid, which changes it between advances.
+    const std::vector<std::uint8_t>* guard = nullptr;
+    /// Zone of a cell: sum over axes of zoneCoord[k][cell coordinate k] * zoneStride[k] (cell centre's zone).
+    std::array<std::vector<std::uint32_t>, D> zoneCoord;
+    std::array<std::uint32_t, D> zoneStride{};
+    std::size_t zones = 0;
+    /// A collision within the TC time (tcTime, the modified EDM's dt_min) hands both particles over, instead of
+    /// only making the collision elastic.
+    bool handoverOnTc = true;
+};
+
 /// Counts of what the engine did.
 struct EdmStats {
     std::uint64_t pairCollisions = 0, wallCollisions = 0;
@@ -57,6 +76,7 @@ struct EdmStats {
     std::uint64_t tcElastic = 0;      ///< collisions made elastic by the TC model
     std::uint64_t restHops = 0;       ///< collisions whose normal speed was raised to the rest-hop speed
     std::uint64_t grazing = 0;        ///< predicted collisions found not approaching (round-off), skipped
+    double dissipated = 0;            ///< kinetic energy lost in collisions (walls: including a moving wall's work) [J]
 };
 
 template <int D>
@@ -72,6 +92,47 @@ public:
     /// Throws SimulationError if the event rate exceeds the bound (EdmSettings::maxEventRate) or a particle's
     /// state is not finite.
     void advanceTo(double t);
+
+    /// Processes all events before t without bringing the particles to t (their clocks stay where their last
+    /// event left them); the World's copy of this engine's particles is stale until synchronise().
+    void advanceEvents(double t);
+    /// Brings every particle of this engine to time t and writes its state to the World; world.time = t.
+    void synchronise(double t);
+
+    // ---- particles joining and leaving (hybrid runs) ----
+    /// Number of particles this engine owns.
+    std::size_t size() const { return nLive_; }
+    bool owns(std::size_t i) const { return i < slotOf_.size() && slotOf_[i] != kNil; }
+    /// Particle i leaves at time t (>= its clock): its state at t is written to the World.
+    void remove(std::size_t i, double t);
+    /// Particle i (not owned) joins at time t with its World state.
+    void add(std::size_t i, double t);
+    /// The World exchanged particles i and j (Particles::swapEntries); owned or not.
+    void swapIndices(std::size_t i, std::size_t j);
+    /// Hybrid coupling: zone volumes and the guard (EdmZoneLink).
+    void attachZones(const EdmZoneLink<D>& link);
+    /// Per zone: volume of this engine's particles in it [m^D] (attachZones first).
+    const std::vector<double>& zoneVolume() const { return zoneVolume_; }
+    /// World indices that entered a cell with a nonzero guard since the last call (may repeat an index; all
+    /// still owned by this engine).
+    std::vector<std::uint32_t> takeGuardEntries();
+    /// World indices of particles that collided within the TC time of their previous collision (with
+    /// EdmZoneLink::handoverOnTc), since the last call.
+    std::vector<std::uint32_t> takeTcHandovers();
+    /// Position of owned particle i at time t (>= its clock), wrapped into the box [m].
+    Vec<D> positionAt(std::size_t i, double t) const;
+    /// Guard value of the cell particle i is in.
+    std::uint32_t cellOfParticle(std::size_t i) const { return rec_[slotOf_[i]].cell; }
+    /// The event grid, for the hybrid's guard.
+    std::uint32_t cellIndex(const Vec<D>& x) const { return cellOf(x); }
+    std::uint32_t cellCount() const { return static_cast<std::uint32_t>(head_.size()); }
+    const std::array<int, D>& cellDims() const { return nCell_; }
+    const Vec<D>& cellWidths() const { return cellW_; }
+    /// Calls f(World index) for every particle of this engine in cell c.
+    template <class F>
+    void forEachInCell(std::uint32_t c, F&& f) const {
+        for (std::uint32_t s = head_[c]; s != kNil; s = link_[s].next) f(rec_[s].idx);
+    }
 
     /// Re-reads every particle from the World (after outside changes at world.time: positions, velocities,
     /// frozen flags, particles added or removed) and re-predicts all events. The engine keeps its own copy of
@@ -139,11 +200,12 @@ private:
     void collideWall(std::uint32_t s, std::uint32_t w, double t);
     void crossCell(std::uint32_t s, int axis, bool up);
     void advance(std::uint32_t s, double t);
-    void synchronise(double t);
+    void syncSlot(std::uint32_t s, double t);
+    std::uint32_t zoneOfCell(std::uint32_t c) const;
     void countEvent(double t);
     Vec<D> posAt(const Hot& h, double t) const;
     Vec<D> velAt(const Hot& h, double t) const;
-    bool frozen(std::uint32_t s) const { return hot_[s].t == kNever; }
+    bool frozen(std::uint32_t s) const { return hot_[s].t == kNever; }  // also true for a free slot
     CollisionLaw lawFor(int matA, int matB, bool elastic) const;
     bool tcElastic(std::uint32_t a, std::uint32_t b, double t) const;  // b = kNil: wall or frozen partner
     void notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop, const Vec<D>& P);
@@ -179,6 +241,16 @@ private:
     std::array<int, D> nCell_{};
     std::array<std::uint32_t, D> stride_{};
     Vec<D> cellW_;
+
+    // particles joining and leaving: World index -> slot (kNil: not owned), free slots (rec_[s].idx == kNil)
+    std::vector<std::uint32_t> slotOf_;
+    std::vector<std::uint32_t> free_;
+    std::size_t nLive_ = 0;
+    // hybrid coupling (attachZones)
+    bool zoned_ = false;
+    EdmZoneLink<D> zone_;
+    std::vector<double> zoneVolume_;
+    std::vector<std::uint32_t> guardEntries_, tcHandovers_;
 
     std::uint64_t events_ = 0, sortedAt_ = 0;
     EdmStats stats_;

@@ -20,6 +20,21 @@ ZoneGrid<D>::ZoneGrid(const Domain<D>& dom, const ZoneSettings& s) : s_(s) {
     phiSmooth_.assign(total_, 0.0);
     dense_.assign(total_, 0);
     tdm_.assign(total_, 0);
+    buildNeighbours();
+}
+
+template <int D>
+void ZoneGrid<D>::buildNeighbours() {
+    auto build = [&](int radius, std::vector<int>& first, std::vector<int>& list) {
+        first.assign(total_ + 1, 0);
+        list.clear();
+        for (int z = 0; z < total_; ++z) {
+            forNeighbours(z, radius, [&](int q) { list.push_back(q); });
+            first[z + 1] = static_cast<int>(list.size());
+        }
+    };
+    build(1, nb1First_, nb1_);
+    build(s_.buffer, nbBFirst_, nbB_);
 }
 
 template <int D>
@@ -70,18 +85,19 @@ void ZoneGrid<D>::forNeighbours(int z, int radius, F&& f) const {
 
 template <int D>
 void ZoneGrid<D>::relabel(const Particles<D>& p, const std::vector<std::uint8_t>& sticky) {
-    std::fill(phi_.begin(), phi_.end(), 0.0);
-    for (std::size_t i = 0; i < p.size(); ++i) phi_[zoneOf(p.x[i])] += Particles<D>::volumeOf(p.radius[i]);
-    for (double& v : phi_) v /= cellVolume_;
+    std::vector<double> vol(total_, 0.0);
+    for (std::size_t i = 0; i < p.size(); ++i) vol[zoneOf(p.x[i])] += Particles<D>::volumeOf(p.radius[i]);
+    relabel(vol, sticky);
+}
+
+template <int D>
+void ZoneGrid<D>::relabel(const std::vector<double>& volume, const std::vector<std::uint8_t>& sticky) {
+    for (int z = 0; z < total_; ++z) phi_[z] = volume[z] / cellVolume_;
     // Smoothing over the zone and its neighbours damps the noise of a few particles crossing a zone edge.
     for (int z = 0; z < total_; ++z) {
         double sum = 0;
-        int cnt = 0;
-        forNeighbours(z, 1, [&](int q) {
-            sum += phi_[q];
-            ++cnt;
-        });
-        phiSmooth_[z] = sum / cnt;
+        for (int k = nb1First_[z]; k < nb1First_[z + 1]; ++k) sum += phi_[nb1_[k]];
+        phiSmooth_[z] = sum / (nb1First_[z + 1] - nb1First_[z]);
     }
     for (int z = 0; z < total_; ++z) {
         const bool stick = z < static_cast<int>(sticky.size()) && sticky[z];
@@ -93,7 +109,7 @@ void ZoneGrid<D>::relabel(const Particles<D>& p, const std::vector<std::uint8_t>
     changed_ = 0;
     for (int z = 0; z < total_; ++z) {
         bool any = false;
-        forNeighbours(z, s_.buffer, [&](int q) { any = any || dense_[q]; });
+        for (int k = nbBFirst_[z]; k < nbBFirst_[z + 1] && !any; ++k) any = dense_[nbB_[k]];
         if (any != static_cast<bool>(tdm_[z])) ++changed_;
         tdm_[z] = any;
     }

@@ -30,6 +30,14 @@ public:
     /// Recomputes the volume fraction of every zone from the particles (centres in the zone), smooths it over
     /// the zone and its neighbours, and updates the labels with hysteresis. sticky[z] != 0 keeps zone z dense.
     void relabel(const Particles<D>& p, const std::vector<std::uint8_t>& sticky);
+    /// The same from the particle volume per zone [m^D] (size count()), when the caller keeps it current.
+    void relabel(const std::vector<double>& volume, const std::vector<std::uint8_t>& sticky);
+    /// Index stride of axis k: zone index = sum of coordinate k * stride(k).
+    int stride(int k) const {
+        int m = 1;
+        for (int q = 0; q < k; ++q) m *= n_[q];
+        return m;
+    }
 
     /// Dense zone (before the buffer).
     bool dense(int z) const { return dense_[z]; }
@@ -46,6 +54,8 @@ private:
     /// Neighbour zones within `radius` (periodic axes wrap; others are clipped), without duplicates.
     template <class F>
     void forNeighbours(int z, int radius, F&& f) const;
+    /// Neighbour lists (CSR) for radius 1 and for the buffer radius, built once.
+    void buildNeighbours();
 
     ZoneSettings s_;
     std::array<int, D> n_{};
@@ -55,6 +65,7 @@ private:
     double cellVolume_ = 1;
     std::vector<double> phi_, phiSmooth_;
     std::vector<std::uint8_t> dense_, tdm_;
+    std::vector<int> nb1First_, nb1_, nbBFirst_, nbB_;
     std::size_t changed_ = 0;
 };
 

@@ -222,6 +222,26 @@ void writeVtpWalls(const std::filesystem::path& path, const std::vector<WallQuad
     arrays.write(path, head);
 }
 
+void writeVtiCells(const std::filesystem::path& path, std::array<int, 3> dims, std::array<double, 3> origin,
+                   std::array<double, 3> spacing, const std::vector<VtkField>& cellData, double time) {
+    std::size_t n = 1;
+    for (int d : dims) {
+        if (d < 1) throw std::invalid_argument("VTK image: every axis needs at least one cell");
+        n *= static_cast<std::size_t>(d);
+    }
+    AppendedArrays arrays;
+    const std::string extent = fmt::format("0 {} 0 {} 0 {}", dims[0], dims[1], dims[2]);
+    std::string head = fileHead("ImageData");
+    head += fmt::format("  <ImageData WholeExtent=\"{}\" Origin=\"{} {} {}\" Spacing=\"{} {} {}\">\n", extent,
+                        origin[0], origin[1], origin[2], spacing[0], spacing[1], spacing[2]);
+    head += timeValue(arrays, arrays.keep(std::vector<double>{time}));
+    head += fmt::format("    <Piece Extent=\"{}\">\n", extent);
+    head += "      <CellData>\n" + arrays.fields(cellData, n, 8) + "      </CellData>\n";
+    head += "    </Piece>\n";
+    head += "  </ImageData>\n";
+    arrays.write(path, head);
+}
+
 PvdCollection::PvdCollection(std::filesystem::path pvdPath) : path_(std::move(pvdPath)) { rewrite(); }
 
 void PvdCollection::add(double time, const std::string& relativeFile, int part) {

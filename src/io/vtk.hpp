@@ -38,6 +38,11 @@ void writeVtuPolygons(const std::filesystem::path& path, std::span<const double>
                       std::span<const std::uint32_t> offsets, const std::vector<VtkField>& cellData,
                       double time);
 
+/// Writes a uniform grid of cells as ImageData (.vti): dims cells per axis (1 for an unused axis), origin and
+/// spacing [m]; each cellData field holds one tuple per cell, x fastest.
+void writeVtiCells(const std::filesystem::path& path, std::array<int, 3> dims, std::array<double, 3> origin,
+                   std::array<double, 3> spacing, const std::vector<VtkField>& cellData, double time);
+
 /// One planar wall as a quadrilateral (2D walls are passed as thin quads by the caller).
 struct WallQuad {
     std::array<std::array<double, 3>, 4> corners{};  ///< [m], in order around the quad

@@ -45,7 +45,7 @@ struct Grid {
 template <int D>
 void sortIntoCells(const Particles<D>& p, const Grid<D>& g, std::vector<std::uint32_t>& cellStart,
                    std::vector<std::uint32_t>& members, std::vector<int>& cellOf) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     cellOf.resize(n);
     cellStart.assign(g.total + 1, 0);
     for (std::size_t i = 0; i < n; ++i) {
@@ -144,7 +144,7 @@ void wrapPositions(Particles<D>& p, const Domain<D>& dom) {
     for (int k = 0; k < D; ++k) {
         if (!dom.periodic[k]) continue;
         const double L = dom.hi[k] - dom.lo[k];
-        for (std::size_t i = 0; i < p.size(); ++i) {
+        for (std::size_t i = 0; i < p.tdmCount(); ++i) {
             double& x = p.x[i][k];
             if (x >= dom.lo[k] && x < dom.hi[k]) continue;
             const double s = std::floor((x - dom.lo[k]) / L);
@@ -159,9 +159,9 @@ void wrapPositions(Particles<D>& p, const Domain<D>& dom) {
 template <int D>
 void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, const PairList<D>& old,
                    PairList<D>& out) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     double rmax = 0;
-    for (double r : p.radius) rmax = std::max(rmax, r);
+    for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
     const Grid<D> g(dom, std::max(2 * rmax + s.skin, 1e-300));
     std::vector<std::uint32_t> cellStart, members;
     std::vector<int> cellOf;
@@ -209,7 +209,7 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
 
 template <int D>
 void buildAllPairs(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, PairList<D>& out) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     out.shiftVec = makeShiftVectors(dom);
     std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> cand(n);
     for (std::uint32_t i = 0; i < n; ++i)
@@ -232,15 +232,19 @@ std::vector<std::uint32_t> spatialOrder(const Particles<D>& p, const Domain<D>& 
 template <int D>
 void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order) {
     const std::size_t n = order.size();
-    std::vector<std::uint32_t> inv(n);
-    for (std::size_t k = 0; k < n; ++k) inv[order[k]] = static_cast<std::uint32_t>(k);
+    const std::size_t nOld = list.first.empty() ? 0 : list.first.size() - 1;
+    constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+    std::vector<std::uint32_t> inv(nOld, kNone);
+    for (std::size_t k = 0; k < n; ++k)
+        if (order[k] < nOld) inv[order[k]] = static_cast<std::uint32_t>(k);
     struct Entry { std::uint32_t i, j; Vec<D> h; };
     std::vector<Entry> kept;
-    if (list.first.size() == n + 1) {
-        for (std::size_t i = 0; i < n; ++i)
+    if (!list.history.empty()) {
+        for (std::size_t i = 0; i < nOld; ++i)
             for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
-                if (list.history.empty() || norm2(list.history[k]) == 0) continue;
-                std::uint32_t a = inv[i], b = inv[list.partner[k]];
+                if (norm2(list.history[k]) == 0) continue;
+                std::uint32_t a = inv[i], b = list.partner[k] < nOld ? inv[list.partner[k]] : kNone;
+                if (a == kNone || b == kNone) continue;  // a particle that left: its contacts end
                 Vec<D> h = list.history[k];
                 if (a > b) { std::swap(a, b); h = -h; }  // xi of (j, i) is -xi of (i, j)
                 kept.push_back({a, b, h});

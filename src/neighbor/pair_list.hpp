@@ -52,6 +52,8 @@ template <int D>
 std::vector<std::uint32_t> spatialOrder(const Particles<D>& p, const Domain<D>& dom, double cellSize);
 
 /// Renumbers a pair list's history after Particles::permute(order), so it can be carried into the next build.
+/// new particle k was old particle order[k]; entries outside the old range (a particle new to the list) have no
+/// history, and pairs of old particles missing from order are dropped.
 template <int D>
 void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order);
 

@@ -18,6 +18,7 @@
 #include "io/series.hpp"
 #include "io/vtk.hpp"
 #include "edm/engine.hpp"
+#include "haet/engine.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
 
@@ -72,6 +73,8 @@ public:
     virtual std::vector<std::string> extraColumns() const = 0;
     virtual std::vector<std::optional<double>> extraRow() const = 0;
     virtual void describe(JsonObject& j) const = 0;   ///< engine facts for run.json
+    /// Hybrid runs: the engine, for the mode field, the zone grid and the picture. Others: nullptr.
+    virtual const HaetEngine<D>* hybrid() const { return nullptr; }
 };
 
 template <int D>
@@ -131,6 +134,82 @@ private:
 };
 
 template <int D>
+class HaetDriver final : public Driver<D> {
+public:
+    HaetDriver(World<D>& w, const TdmSettings& ts, const EdmSettings& es, const HaetSettings& hs, std::string dtNote)
+        : eng_(w, ts, es, hs), note_(std::move(dtNote)) {}
+    const char* method() const override { return "haet"; }
+    void advanceTo(double t) override {
+        eng_.advanceTo(t);
+        eng_.synchronise();
+    }
+    double timeTolerance() const override { return 0.5 * eng_.dt(); }
+    std::uint64_t steps() const override { return eng_.steps(); }
+    std::size_t contacts() const override { return eng_.tdm().forceStats().contacts; }
+    double maxOverlapRatio() const override { return eng_.tdm().forceStats().maxOverlapRatio; }
+    double elasticEnergy() const override { return eng_.tdm().contactEnergy(); }
+    double virial(double window) override {
+        return eng_.tdm().pairVirial() + (window > 0 ? edmVirial() / window : 0.0);
+    }
+    std::vector<std::string> extraColumns() const override {
+        return {"n_tdm", "n_edm", "events", "collisions", "tdm_steps", "to_tdm", "to_edm", "tc_handovers",
+                "dissipated_tdm", "dissipated_edm", "energy_unaccounted"};
+    }
+    std::vector<std::optional<double>> extraRow() const override {
+        const HaetEnergy e = eng_.energy();
+        const HaetCounters& c = eng_.counters();
+        return {double(eng_.nTdm()), double(eng_.nEdm()), double(eng_.events()), double(eng_.collisions()),
+                double(eng_.steps()), double(c.toTdm), double(c.toEdm), double(c.tcHandovers), e.dissipatedTdm,
+                e.dissipatedEdm, e.unaccounted};
+    }
+    void describe(JsonObject& j) const override {
+        const HaetCounters& c = eng_.counters();
+        j.add("dt", eng_.dt());
+        j.add("dt_rule", note_);
+        j.add("dt_min", eng_.dtMin());
+        j.add("zone_size", eng_.settings().zones.size);
+        j.add("events", eng_.events());
+        j.add("collisions", eng_.collisions());
+        j.add("n_tdm", eng_.nTdm());
+        j.add("n_edm", eng_.nEdm());
+        j.add("to_tdm", c.toTdm);
+        j.add("to_edm", c.toEdm);
+        j.add("tc_handovers", c.tcHandovers);
+        j.add("relabels", c.relabels);
+        j.add("neighbor_rebuilds", eng_.tdm().rebuilds());
+    }
+    const HaetEngine<D>* hybrid() const override { return &eng_; }
+
+private:
+    double edmVirial() { return const_cast<EdmEngine<D>&>(eng_.edm()).takeCollisionVirial(); }
+    HaetEngine<D> eng_;
+    std::string note_;
+};
+
+/// The hybrid's settings from the scenario, with the documented defaults (PHYSICS.md A).
+inline HaetSettings haetSettings(const Scenario& sc) {
+    HaetSettings hs;
+    hs.zones.size = sc.haet.zoneSize.value_or(0.0);
+    hs.zones.phiOn = sc.haet.phiOn.value_or(sc.dimension == 2 ? 0.45 : 0.30);
+    hs.zones.phiOff = sc.haet.phiOff.value_or(sc.dimension == 2 ? 0.40 : 0.25);
+    hs.zones.buffer = sc.haet.buffer;
+    hs.relabelEvery = sc.haet.relabelEvery;
+    hs.diluteSteps = sc.haet.diluteSteps;
+    hs.dtMin = sc.haet.dtMin.value_or(0.0);
+    return hs;
+}
+
+inline EdmSettings edmSettings(const Scenario& sc) {
+    EdmSettings es;
+    es.cellSize = sc.edm.cellSize.value_or(0.0);
+    es.tangential = sc.edm.tangential == EdmTangential::Constant ? EdmSettings::Tangential::Constant
+                                                                  : EdmSettings::Tangential::Walton;
+    es.tcModel = sc.edm.tcModel;
+    es.tcTime = sc.edm.tcTime.value_or(0.0);
+    return es;
+}
+
+template <int D>
 std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
     switch (sc.method) {
         case Method::Tdm: {
@@ -138,26 +217,23 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
             return std::make_unique<TdmDriver<D>>(world, ts, note);
         }
-        case Method::Edm: {
-            EdmSettings es;
-            es.cellSize = sc.edm.cellSize.value_or(0.0);
-            es.tangential = sc.edm.tangential == EdmTangential::Constant ? EdmSettings::Tangential::Constant
-                                                                          : EdmSettings::Tangential::Walton;
-            es.tcModel = sc.edm.tcModel;
-            es.tcTime = sc.edm.tcTime.value_or(0.0);
-            return std::make_unique<EdmDriver<D>>(world, es);
+        case Method::Edm: return std::make_unique<EdmDriver<D>>(world, edmSettings(sc));
+        case Method::Haet: {
+            std::string note;
+            const TdmSettings ts = tdmSettings<D>(sc, world, &note);
+            return std::make_unique<HaetDriver<D>>(world, ts, edmSettings(sc), haetSettings(sc), note);
         }
-        case Method::Haet: break;
     }
-    throw ScenarioError({sc.path, 0}, "method", "\"haet\" is not available in this version (use \"tdm\" or \"edm\")");
+    throw ScenarioError({sc.path, 0}, "method", "unknown method");
 }
 
 template <int D>
 class SnapshotWriter {
 public:
-    SnapshotWriter(const std::filesystem::path& dir) : dir_(dir), pvd_(dir / "particles.pvd"), walls_(dir / "walls.pvd") {}
+    SnapshotWriter(const std::filesystem::path& dir)
+        : dir_(dir), pvd_(dir / "particles.pvd"), walls_(dir / "walls.pvd"), zones_(dir / "zones.pvd") {}
 
-    void write(const World<D>& w, double time) {
+    void write(const World<D>& w, double time, const HaetEngine<D>* hybrid) {
         const Particles<D>& p = w.particles;
         const std::size_t n = p.size();
         std::vector<double> xyz(3 * n, 0.0), vel(3 * n, 0.0), spin(3 * n, 0.0), force(3 * n, 0.0), rad(n);
@@ -176,15 +252,21 @@ public:
             mat[i] = p.material[i];
         }
         const std::string name = fmt::format("particles_{:06d}.vtu", count_);
-        writeVtuPoints(dir_ / name, n, xyz.data(),
-                       {{"radius", 1, VtkField::Float64, rad.data()},
-                        {"velocity", 3, VtkField::Float64, vel.data()},
-                        {"angular_velocity", 3, VtkField::Float64, spin.data()},
-                        {"force", 3, VtkField::Float64, force.data()},
-                        {"material", 1, VtkField::Int32, mat.data()},
-                        {"id", 1, VtkField::Int64, ids.data()}},
-                       time);
+        std::vector<VtkField> fields = {{"radius", 1, VtkField::Float64, rad.data()},
+                                        {"velocity", 3, VtkField::Float64, vel.data()},
+                                        {"angular_velocity", 3, VtkField::Float64, spin.data()},
+                                        {"force", 3, VtkField::Float64, force.data()},
+                                        {"material", 1, VtkField::Int32, mat.data()},
+                                        {"id", 1, VtkField::Int64, ids.data()}};
+        std::vector<std::int32_t> mode;
+        if (hybrid) {  // 1: time-driven, 0: event-driven
+            mode.resize(n);
+            for (std::size_t i = 0; i < n; ++i) mode[i] = i < p.tdmCount() ? 1 : 0;
+            fields.push_back({"mode", 1, VtkField::Int32, mode.data()});
+        }
+        writeVtuPoints(dir_ / name, n, xyz.data(), fields, time);
         pvd_.add(time, name);
+        if (hybrid) writeZones(*hybrid, time);
         if (!w.walls.empty()) {
             const std::string wname = fmt::format("walls_{:06d}.vtp", count_);
             writeVtpWalls(dir_ / wname, wallQuads(w, time));
@@ -194,6 +276,29 @@ public:
     }
 
 private:
+    /// Zone labels as an image: label 0 event-driven, 1 time-driven (buffer), 2 dense; smoothed fraction phi.
+    void writeZones(const HaetEngine<D>& h, double time) {
+        const ZoneGrid<D>& z = h.zones();
+        const int nz = z.count();
+        std::vector<std::int32_t> label(nz);
+        std::vector<double> phi(nz);
+        for (int q = 0; q < nz; ++q) {
+            label[q] = z.dense(q) ? 2 : (z.timeDriven(q) ? 1 : 0);
+            phi[q] = z.smoothed(q);
+        }
+        std::array<int, 3> dims{1, 1, 1};
+        std::array<double, 3> origin{0, 0, 0}, spacing{1, 1, 1};
+        for (int k = 0; k < D; ++k) {
+            dims[k] = z.dims()[k];
+            origin[k] = z.origin()[k];
+            spacing[k] = z.zoneWidth()[k];
+        }
+        const std::string name = fmt::format("zones_{:06d}.vti", count_);
+        writeVtiCells(dir_ / name, dims, origin, spacing,
+                      {{"label", 1, VtkField::Int32, label.data()}, {"phi", 1, VtkField::Float64, phi.data()}}, time);
+        zones_.add(time, name);
+    }
+
     /// A wall as a square patch covering the box (a thin quad in 2D).
     static std::vector<WallQuad> wallQuads(const World<D>& w, double time) {
         std::vector<WallQuad> quads;
@@ -235,12 +340,13 @@ private:
     }
 
     std::filesystem::path dir_;
-    PvdCollection pvd_, walls_;
+    PvdCollection pvd_, walls_, zones_;
     int count_ = 0;
 };
 
-/// A picture of a 2D state: disks coloured by speed (blue slow, red fast), walls as lines.
-void writePicture(const World<2>& w, const std::filesystem::path& path) {
+/// A picture of a 2D state: disks coloured by speed (blue slow, red fast), or in a hybrid run by mode (time-driven
+/// blue, event-driven orange, darker when slow); walls as lines.
+void writePicture(const World<2>& w, const std::filesystem::path& path, bool byMode) {
     PngScene scene;
     scene.lo = {w.domain.lo[0], w.domain.lo[1]};
     scene.hi = {w.domain.hi[0], w.domain.hi[1]};
@@ -250,8 +356,18 @@ void writePicture(const World<2>& w, const std::filesystem::path& path) {
     for (std::size_t i = 0; i < p.size(); ++i) vmax = std::max(vmax, norm(p.v[i]));
     for (std::size_t i = 0; i < p.size(); ++i) {
         const double s = vmax > 0 ? norm(p.v[i]) / vmax : 0;
-        const auto r = static_cast<std::uint32_t>(60 + 195 * s), b = static_cast<std::uint32_t>(255 - 195 * s);
-        scene.disks.push_back({p.x[i][0], p.x[i][1], p.radius[i], p.frozen(i) ? 0x606060u : (r << 16) | (90u << 8) | b});
+        std::uint32_t colour;
+        if (p.frozen(i)) {
+            colour = 0x606060u;
+        } else if (byMode) {
+            const double k = 0.55 + 0.45 * std::sqrt(s);
+            auto ch = [&](double c) { return static_cast<std::uint32_t>(std::clamp(c * k, 0.0, 255.0)); };
+            colour = i < p.tdmCount() ? (ch(40) << 16) | (ch(110) << 8) | ch(235) : (ch(255) << 16) | (ch(150) << 8) | ch(20);
+        } else {
+            const auto r = static_cast<std::uint32_t>(60 + 195 * s), b = static_cast<std::uint32_t>(255 - 195 * s);
+            colour = (r << 16) | (90u << 8) | b;
+        }
+        scene.disks.push_back({p.x[i][0], p.x[i][1], p.radius[i], colour});
     }
     for (const Wall<2>& wl : w.walls) {
         const Vec<2> pt = wl.pointAt(w.time);
@@ -259,7 +375,11 @@ void writePicture(const World<2>& w, const std::filesystem::path& path) {
         const double L = norm(w.domain.length());
         scene.walls.push_back({pt[0] - t[0] * L, pt[1] - t[1] * L, pt[0] + t[0] * L, pt[1] + t[1] * L});
     }
-    scene.caption = fmt::format("t = {:.4g} s, {} particles (colour: speed, max {:.3g} m/s)", w.time, p.size(), vmax);
+    if (byMode)
+        scene.caption = fmt::format("t = {:.4g} s, {} particles: {} time-driven (blue), {} event-driven (orange)",
+                                    w.time, p.size(), p.tdmCount(), p.size() - p.tdmCount());
+    else
+        scene.caption = fmt::format("t = {:.4g} s, {} particles (colour: speed, max {:.3g} m/s)", w.time, p.size(), vmax);
     writePng(path, scene);
 }
 
@@ -362,7 +482,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                 nextSeries += seriesPeriod;
             }
             if (snapPeriod > 0 && world.time + eps >= nextSnap) {
-                snaps.write(world, world.time);
+                snaps.write(world, world.time, eng->hybrid());
                 series.flush();
                 nextSnap += snapPeriod;
             }
@@ -384,7 +504,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     progress.finish();
     series.flush();
     writeRunJson(statusText);
-    if constexpr (D == 2) writePicture(world, dir / "final.png");
+    if constexpr (D == 2) writePicture(world, dir / "final.png", eng->hybrid() != nullptr);
     if (!opt.quiet) {
         const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
         log << fmt::format("{} ({}): {} particles, simulated {:.4g} s in {:.2f} s wall time; outputs in {}\n",
@@ -449,7 +569,43 @@ void describeEdm(const Scenario& sc, std::ostream& out) {
                            sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
 }
 
+template <int D>
+void describeHaet(const Scenario& sc, std::ostream& out) {
+    World<D> world = buildWorld<D>(sc);
+    std::string dtNote;
+    const TdmSettings ts = tdmSettings<D>(sc, world, &dtNote);
+    const HaetEngine<D> eng(world, ts, edmSettings(sc), haetSettings(sc));
+    const HaetSettings& hs = eng.settings();
+    out << fmt::format("scenario   {} ({})\n", sc.name, sc.path);
+    out << fmt::format("method     haet (time-driven where dense, event-driven where dilute), {}D, integrator {}\n", D,
+                       ts.integrator == IntegratorKind::Gear5 ? "gear5" : "verlet");
+    out << fmt::format("particles  {}: {} time-driven, {} event-driven at the start; {} walls\n",
+                       world.particles.size(), eng.nTdm(), eng.nEdm(), world.walls.size());
+    out << fmt::format("contact    t_c = {:.4g} s ({})\n", world.contact.contactTime, world.contact.contactTimeNote);
+    out << fmt::format("time step  dt = {:.4g} s ({}); {:.0f} steps for {:.4g} s\n", ts.dt, dtNote,
+                       std::ceil(sc.duration / ts.dt), sc.duration);
+    const ZoneGrid<D>& z = eng.zones();
+    std::string dims;
+    for (int k = 0; k < D; ++k) dims += (k ? " x " : "") + std::to_string(z.dims()[k]);
+    out << fmt::format("zones      edge {:.4g} m ({} zones), phi_on {:.3g}, phi_off {:.3g}, buffer {}, "
+                       "relabel every {} steps, dilute_steps {}\n",
+                       hs.zones.size, dims, hs.zones.phiOn, hs.zones.phiOff, hs.zones.buffer, hs.relabelEvery,
+                       hs.diluteSteps);
+    out << fmt::format("collapse   modified EDM: dt_min = {:.4g} s (a collision sooner hands both particles to the TDM)\n",
+                       eng.dtMin());
+    for (std::size_t a = 0; a < sc.materials.size(); ++a)
+        out << fmt::format("material   {}: restitution {:.5f} in both engines (the soft law's, incl. contact-end rule)\n",
+                           sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+}
+
 void describeScenario(const Scenario& sc, std::ostream& out) {
+    if (sc.method == Method::Haet) {
+        if (sc.dimension == 2)
+            describeHaet<2>(sc, out);
+        else
+            describeHaet<3>(sc, out);
+        return;
+    }
     if (sc.method == Method::Edm) {
         if (sc.dimension == 2)
             describeEdm<2>(sc, out);
@@ -457,8 +613,6 @@ void describeScenario(const Scenario& sc, std::ostream& out) {
             describeEdm<3>(sc, out);
         return;
     }
-    if (sc.method != Method::Tdm)
-        throw ScenarioError({sc.path, 0}, "method", "\"haet\" is not available in this version (use \"tdm\" or \"edm\")");
     if (sc.dimension == 2)
         describeTdm<2>(sc, out);
     else

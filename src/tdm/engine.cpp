@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 namespace haet {
 
@@ -11,7 +12,7 @@ TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s
         integ_ = std::make_unique<Gear5<D>>();
     else
         integ_ = std::make_unique<VelocityVerlet<D>>();
-    wallHistory_.assign(w_.particles.size() * w_.walls.size(), Vec<D>::zero());
+    wallHistory_.assign(w_.particles.tdmCount() * w_.walls.size(), Vec<D>::zero());
     rebuildIfNeeded(true);
     motion_.v = w_.particles.v;
     motion_.w = w_.particles.w;
@@ -48,7 +49,7 @@ void TdmEngine<D>::computeForces() {
 template <int D>
 void TdmEngine<D>::rebuildIfNeeded(bool force) {
     Particles<D>& p = w_.particles;
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     if (!force) {
         const double lim2 = 0.25 * s_.skin * s_.skin;
         bool moved = false;
@@ -57,10 +58,17 @@ void TdmEngine<D>::rebuildIfNeeded(bool force) {
             if (norm2(p.x[i] - xAtBuild_[i]) > lim2) moved = true;
         if (!moved) return;
     }
+    rebuild(s_.sortEvery > 0 && (force || steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery)));
+}
+
+template <int D>
+void TdmEngine<D>::rebuild(bool sort) {
+    Particles<D>& p = w_.particles;
+    const std::size_t n = p.tdmCount();
     wrapPositions(p, w_.domain);
-    if (s_.sortEvery > 0 && (force || steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery))) {
+    if (sort) {
         double rmax = 0;
-        for (double r : p.radius) rmax = std::max(rmax, r);
+        for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
         const auto order = spatialOrder(p, w_.domain, 2 * rmax + s_.skin);
         p.permute(order);
         permutePairList(pairs_, order);
@@ -85,8 +93,59 @@ void TdmEngine<D>::rebuildIfNeeded(bool force) {
     PairList<D> fresh;
     buildPairList(p, w_.domain, NeighborSettings{s_.skin, true}, pairs_, fresh);
     pairs_ = std::move(fresh);
-    xAtBuild_ = p.x;
+    xAtBuild_.assign(p.x.begin(), p.x.begin() + static_cast<std::ptrdiff_t>(n));
     ++rebuilds_;
+}
+
+template <int D>
+void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
+    Particles<D>& p = w_.particles;
+    const std::size_t n = p.tdmCount();
+    if (from.size() != n) throw std::invalid_argument("TdmEngine::remap: map size differs from tdmCount()");
+    const std::size_t nw = w_.walls.size();
+    std::vector<Vec<D>> wh(n * nw, Vec<D>::zero());
+    std::vector<Vec<D>> mv(n);
+    std::vector<Ang<D>> mw(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::uint32_t o = from[k];
+        if (o == kFresh) {
+            // Free flight: the force of gravity alone, no spin change.
+            p.f[k] = p.frozen(k) ? Vec<D>::zero() : w_.domain.gravity * p.mass[k];
+            p.torque[k] = Ang<D>::zero();
+            mv[k] = p.v[k];
+            mw[k] = p.w[k];
+            continue;
+        }
+        for (std::size_t q = 0; q < nw; ++q) wh[k * nw + q] = wallHistory_[o * nw + q];
+        if (o < motion_.v.size()) {
+            mv[k] = motion_.v[o];
+            mw[k] = motion_.w[o];
+        }
+    }
+    wallHistory_.swap(wh);
+    motion_.v.swap(mv);
+    motion_.w.swap(mw);
+    permutePairList(pairs_, from);
+    integ_->remap(p, from, s_.dt);
+    rebuild(false);
+}
+
+template <int D>
+void TdmEngine<D>::contactFlags(std::vector<std::uint8_t>& out) const {
+    const Particles<D>& p = w_.particles;
+    const std::size_t n = p.tdmCount();
+    out.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::uint32_t k = pairs_.first[i]; k < pairs_.first[i + 1]; ++k) {
+            const std::uint32_t j = pairs_.partner[k];
+            const Vec<D> d = p.x[i] - p.x[j] + pairs_.shiftVec[pairs_.shift[k]];
+            const double rs = p.radius[i] + p.radius[j];
+            if (norm2(d) < rs * rs) out[i] = out[j] = 1;
+        }
+        if (out[i]) continue;
+        for (const Wall<D>& wall : w_.walls)
+            if (wall.distance(p.x[i], w_.time) < p.radius[i]) out[i] = 1;
+    }
 }
 
 template <int D>
@@ -122,7 +181,7 @@ void TdmEngine<D>::checkHealth() const {
         fail(stats_.worstParticle, os.str());
     }
     // A NaN anywhere reaches the force of its particle in the same step.
-    for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t i = 0; i < p.tdmCount(); ++i) {
         const Vec<D>& f = p.f[i];
         double s = 0;
         for (int k = 0; k < D; ++k) s += f[k] + p.x[i][k];
@@ -139,7 +198,7 @@ double TdmEngine<D>::contactEnergy() const {
         return 0.4 * c.hertzK * std::sqrt(reff) * std::pow(delta, 2.5);
     };
     double e = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t i = 0; i < p.tdmCount(); ++i) {
         for (std::uint32_t k = pairs_.first[i]; k < pairs_.first[i + 1]; ++k) {
             const std::uint32_t j = pairs_.partner[k];
             const Vec<D> d = p.x[i] - p.x[j] + pairs_.shiftVec[pairs_.shift[k]];

@@ -38,6 +38,15 @@ public:
     const ForceStats& forceStats() const { return stats_; }
     const PairList<D>& pairs() const { return pairs_; }
 
+    /// After the particles in [0, tdmCount()) changed (a hybrid moved some in or out): new particle k was old
+    /// particle from[k], or is new to this engine (kFresh). Per-particle history follows; a new particle starts
+    /// with no contact history and the integrator history of free flight under gravity (it comes from ballistic
+    /// flight); the pair list is rebuilt. Call at a step boundary.
+    static constexpr std::uint32_t kFresh = 0xFFFFFFFFu;
+    void remap(const std::vector<std::uint32_t>& from);
+    /// out[i] = 1 if particle i touches another particle or a wall at the current positions (i < tdmCount()).
+    void contactFlags(std::vector<std::uint8_t>& out) const;
+
     /// Elastic energy stored in contacts (pairs and walls) [J].
     double contactEnergy() const;
     /// Sum over contacts of r_ij . F_ij [J] (pair virial; walls excluded).
@@ -46,6 +55,7 @@ public:
 private:
     void computeForces();
     void rebuildIfNeeded(bool force);
+    void rebuild(bool sort);
     void checkHealth() const;
 
     World<D>& w_;

@@ -96,7 +96,7 @@ template <int D, class Normal, class Tangential>
 ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wall<D>>& walls,
                          std::vector<Vec<D>>& wallHistory, const ContactSetup& cs, const Domain<D>& dom,
                          double time, double dt, const Vec<D>* sv, const Ang<D>* sw, ForceScratch<D>& s) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     const std::size_t np = pl.size();
     s.maxOverlap.assign(n, 0.0);
     s.contacts.assign(n, 0);

@@ -5,16 +5,33 @@ namespace haet {
 template <class T>
 static void permuteVec(std::vector<T>& a, const std::vector<std::uint32_t>& order) {
     if (a.empty()) return;
-    std::vector<T> tmp(a.size());
+    std::vector<T> tmp(a);  // entries beyond order.size() stay
     for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = a[order[k]];
     a.swap(tmp);
+}
+
+/// a[k] = old a[from[k]]; entries for new particles (from[k] = kNew) are value-initialised.
+template <class T>
+static void remapVec(std::vector<T>& a, const std::vector<std::uint32_t>& from) {
+    constexpr std::uint32_t kNew = 0xFFFFFFFFu;
+    std::vector<T> tmp(from.size(), T{});
+    for (std::size_t k = 0; k < from.size(); ++k)
+        if (from[k] != kNew && from[k] < a.size()) tmp[k] = a[from[k]];
+    a.swap(tmp);
+}
+
+/// Restarts every new particle of a remap.
+template <class I, class P>
+static void restartNew(I& integ, const P& p, const std::vector<std::uint32_t>& from, double dt) {
+    for (std::size_t k = 0; k < from.size(); ++k)
+        if (from[k] == 0xFFFFFFFFu) integ.restart(p, k, dt);
 }
 
 // ---- velocity Verlet ----
 
 template <int D>
 void VelocityVerlet<D>::start(const Particles<D>& p, double) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     acc_.resize(n);
     alpha_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -25,7 +42,7 @@ void VelocityVerlet<D>::start(const Particles<D>& p, double) {
 
 template <int D>
 void VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     const double h2 = 0.5 * dt * dt;
     m.v.resize(n);
     m.w.resize(n);
@@ -57,7 +74,7 @@ void VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
 
 template <int D>
 void VelocityVerlet<D>::correct(Particles<D>& p, double dt) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     const double h = 0.5 * dt;
     Vec<D>* __restrict v = p.v.data();
     Ang<D>* __restrict w = p.w.data();
@@ -87,10 +104,17 @@ void VelocityVerlet<D>::permute(const std::vector<std::uint32_t>& order) {
 }
 
 template <int D>
+void VelocityVerlet<D>::remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) {
+    remapVec(acc_, from);
+    remapVec(alpha_, from);
+    restartNew(*this, p, from, dt);
+}
+
+template <int D>
 void VelocityVerlet<D>::restart(const Particles<D>& p, std::size_t i, double) {
-    if (acc_.size() < p.size()) {
-        acc_.resize(p.size());
-        alpha_.resize(p.size());
+    if (acc_.size() < p.tdmCount()) {
+        acc_.resize(p.tdmCount());
+        alpha_.resize(p.tdmCount());
     }
     acc_[i] = p.f[i] * p.invMass[i];
     alpha_[i] = p.torque[i] * p.invInertia[i];
@@ -100,17 +124,24 @@ void VelocityVerlet<D>::restart(const Particles<D>& p, std::size_t i, double) {
 
 template <int D>
 void Gear5<D>::start(const Particles<D>& p, double dt) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     for (auto& a : y_) a.assign(n, Vec<D>::zero());
     for (auto& a : r_) a.assign(n, Ang<D>::zero());
     for (std::size_t i = 0; i < n; ++i) restart(p, i, dt);
 }
 
 template <int D>
+void Gear5<D>::remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) {
+    for (auto& a : y_) remapVec(a, from);
+    for (auto& a : r_) remapVec(a, from);
+    restartNew(*this, p, from, dt);
+}
+
+template <int D>
 void Gear5<D>::restart(const Particles<D>& p, std::size_t i, double dt) {
-    if (y_[0].size() < p.size()) {
-        for (auto& a : y_) a.resize(p.size(), Vec<D>::zero());
-        for (auto& a : r_) a.resize(p.size(), Ang<D>::zero());
+    if (y_[0].size() < p.tdmCount()) {
+        for (auto& a : y_) a.resize(p.tdmCount(), Vec<D>::zero());
+        for (auto& a : r_) a.resize(p.tdmCount(), Ang<D>::zero());
     }
     // Higher derivatives from the current force with zero jerk: exact for free flight under gravity, and the
     // best local guess for a particle not yet in contact (PHYSICS.md F.1).
@@ -165,7 +196,7 @@ inline void gearCorrect(Vec<N>& x, Vec<N>& v, Vec<N>& y2, Vec<N>& y3, Vec<N>& y4
 
 template <int D>
 void Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
     m.v.resize(n);
     m.w.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
@@ -182,7 +213,7 @@ void Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
 
 template <int D>
 void Gear5<D>::correct(Particles<D>& p, double dt) {
-    const std::size_t n = p.size();
+    const std::size_t n = p.tdmCount();
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
         if (p.flags[i] & kFrozen) continue;

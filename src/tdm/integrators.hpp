@@ -30,6 +30,9 @@ public:
     virtual void permute(const std::vector<std::uint32_t>& order) = 0;
     /// Re-initialises the history of particle i from its current state and force (HAET mode switch).
     virtual void restart(const Particles<D>& p, std::size_t i, double dt) = 0;
+    /// After the particle set changed: new particle k was old particle from[k], or is new (0xFFFFFFFF) and
+    /// restarts from its current state and force.
+    virtual void remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) = 0;
 };
 
 /// Velocity Verlet (Swope et al. 1982; F.2). Forces see v* = v + a(t) dt, the explicit estimate of v(t+dt).
@@ -41,6 +44,7 @@ public:
     void correct(Particles<D>& p, double dt) override;
     void permute(const std::vector<std::uint32_t>& order) override;
     void restart(const Particles<D>& p, std::size_t i, double dt) override;
+    void remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) override;
 
 private:
     std::vector<Vec<D>> acc_;    ///< a(t) [m/s^2]
@@ -59,6 +63,7 @@ public:
     void correct(Particles<D>& p, double dt) override;
     void permute(const std::vector<std::uint32_t>& order) override;
     void restart(const Particles<D>& p, std::size_t i, double dt) override;
+    void remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) override;
 
     /// Sets the scaled higher derivatives of particle i from unscaled ones (a, jerk, snap, crackle):
     /// consistent start-up when the caller knows them (PHYSICS.md F.1 start-up pitfall).

@@ -1,0 +1,504 @@
+#include "haet/engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace haet {
+
+namespace {
+constexpr std::uint32_t kNil = 0xFFFFFFFFu;
+
+template <int D>
+double largestRadius(const Particles<D>& p) {
+    double r = 0;
+    for (double x : p.radius) r = std::max(r, x);
+    return r;
+}
+
+/// Defaults that depend on the particles: the zone edge is 4 largest diameters, never below one.
+template <int D>
+HaetSettings resolved(const World<D>& w, HaetSettings hs) {
+    const double d = 2 * largestRadius(w.particles);
+    if (!(hs.zones.size > 0)) hs.zones.size = 4 * d;
+    hs.zones.size = std::max(hs.zones.size, d);
+    if (!(hs.zones.size > 0)) hs.zones.size = 1;
+    hs.relabelEvery = std::max(1, hs.relabelEvery);
+    hs.diluteSteps = std::max(0, hs.diluteSteps);
+    return hs;
+}
+}  // namespace
+
+template <int D>
+HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings edm, const HaetSettings& hs)
+    : w_(world), ts_(tdm), hs_(resolved(world, hs)), zones_(world.domain, hs_.zones) {
+    Particles<D>& p = w_.particles;
+    const std::size_t n = p.size();
+    const double rmax = largestRadius(p);
+
+    // Initial labels from every particle, then the split: time-driven particles first.
+    zones_.relabel(p, {});
+    lastTdmStep_.assign(zones_.count(), 0);
+    denseUntil_.assign(zones_.count(), 0);
+    std::vector<std::uint32_t> order;
+    order.reserve(n);
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (zones_.timeDriven(zones_.zoneOf(p.x[i]))) order.push_back(i);
+    const std::size_t nT = order.size();
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (!zones_.timeDriven(zones_.zoneOf(p.x[i]))) order.push_back(i);
+    p.permute(order);
+    p.nTdm = nT;
+
+    // The event grid's cells hold one particle diameter plus the TDM skin: a particle in a cell next to a TDM
+    // particle's cell is at least a skin's width from touching it (docs/haet.md).
+    edm.firstParticle = nT;
+    if (hs_.dtMin > 0) edm.tcTime = hs_.dtMin;
+    edm.tcModel = true;
+    edm.cellSize = std::max(edm.cellSize, 2 * rmax + ts_.skin);
+    edm_ = std::make_unique<EdmEngine<D>>(w_, edm);
+    const std::array<int, D>& nc = edm_->cellDims();
+    EdmZoneLink<D> link;
+    guard_.assign(edm_->cellCount(), 0);
+    binHead_.assign(edm_->cellCount(), kNil);
+    link.guard = &guard_;
+    link.zones = static_cast<std::size_t>(zones_.count());
+    for (int k = 0; k < D; ++k) {
+        const int nz = zones_.dims()[k];
+        link.zoneStride[k] = static_cast<std::uint32_t>(zones_.stride(k));
+        link.zoneCoord[k].resize(nc[k]);
+        zoneCellBegin_[k].assign(nz + 1, static_cast<std::uint32_t>(nc[k]));
+        for (int c = nc[k]; c-- > 0;) {
+            const double xc = (c + 0.5) * edm_->cellWidths()[k];
+            const int z = std::clamp(static_cast<int>(std::floor(xc / zones_.zoneWidth()[k])), 0, nz - 1);
+            link.zoneCoord[k][c] = static_cast<std::uint32_t>(z);
+            zoneCellBegin_[k][z] = static_cast<std::uint32_t>(c);
+        }
+        // Zones holding no cell centre (a zone narrower than a cell): an empty range.
+        for (int z = nz; z-- > 0;) zoneCellBegin_[k][z] = std::min(zoneCellBegin_[k][z], zoneCellBegin_[k][z + 1]);
+    }
+    edm_->attachZones(link);
+    tdm_ = std::make_unique<TdmEngine<D>>(w_, ts_);
+    margin_ = std::max(ts_.skin, 0.1 * rmax);
+
+    // Energy baselines, then the first relabel (guard, stragglers).
+    for (std::size_t i = 0; i < n; ++i) e0_ += particleEnergy(i);
+    e0_ += tdm_->contactEnergy();
+    tdm0_ = tdmEnergy();
+    relabel({});
+}
+
+template <int D>
+HaetEngine<D>::~HaetEngine() = default;
+
+// ---------------------------------------------------------------------------------------------------------------
+
+template <int D>
+void HaetEngine<D>::step() {
+    const double t1 = w_.time + ts_.dt;
+    edm_->advanceEvents(t1);
+    const std::uint64_t rebuilds = tdm_->rebuilds();
+    tdm_->step();
+    ++steps_;
+    std::vector<std::uint32_t> arrivals;
+    for (const std::uint32_t i : edm_->takeTcHandovers()) {
+        if (frozenModes_ || !edm_->owns(i)) continue;
+        arrivals.push_back(i);
+        ++counters_.tcHandovers;
+        denseUntil_[zones_.zoneOf(edm_->positionAt(i, w_.time))] = steps_ + hs_.diluteSteps + hs_.relabelEvery;
+    }
+    for (const std::uint32_t i : edm_->takeGuardEntries()) {
+        if (frozenModes_ || !edm_->owns(i)) continue;
+        const std::uint8_t level = guard_[edm_->cellOfParticle(i)];
+        if (level >= 2)
+            arrivals.push_back(i);
+        else if (level == 1)
+            watch_.push_back(i);
+    }
+    if (frozenModes_) return;
+    checkWatched(arrivals);
+    // TDM particles move less than skin/2 between pair-list builds: relabelling at each build keeps the guard's
+    // picture of them within that distance.
+    if (steps_ % static_cast<std::uint64_t>(hs_.relabelEvery) == 0 || tdm_->rebuilds() != rebuilds)
+        relabel(std::move(arrivals));
+    else if (!arrivals.empty())
+        convert(std::move(arrivals), {});
+}
+
+template <int D>
+void HaetEngine<D>::advanceTo(double t) {
+    while (w_.time + 0.5 * ts_.dt <= t) step();
+}
+
+template <int D>
+void HaetEngine<D>::synchronise() {
+    edm_->synchronise(w_.time);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// the guard
+
+template <int D>
+std::array<int, D> HaetEngine<D>::cellCoords(std::uint32_t c) const {
+    std::array<int, D> a;
+    const std::array<int, D>& nc = edm_->cellDims();
+    for (int k = 0; k < D; ++k) {
+        a[k] = static_cast<int>(c % static_cast<std::uint32_t>(nc[k]));
+        c /= static_cast<std::uint32_t>(nc[k]);
+    }
+    return a;
+}
+
+template <int D>
+void HaetEngine<D>::bin(const Vec<D>& x, double r) {
+    const std::uint32_t c = edm_->cellIndex(x);
+    if (binHead_[c] == kNil) binCells_.push_back(c);
+    bins_.push_back(Binned{x, r, binHead_[c]});
+    binHead_[c] = static_cast<std::uint32_t>(bins_.size() - 1);
+}
+
+// The 3^D cells around `cell` get at least `level` (in the new-level bits 2-3 during a relabel).
+template <int D>
+void HaetEngine<D>::markAround(std::uint32_t cell, std::uint8_t level, std::vector<std::uint32_t>& arrivals) {
+    const std::array<int, D> cc = cellCoords(cell);
+    const std::array<int, D>& nc = edm_->cellDims();
+    constexpr int m = D == 3 ? 27 : 9;
+    for (int code = 0; code < m; ++code) {
+        std::uint32_t idx = 0, stride = 1;
+        bool ok = true;
+        int q = code;
+        for (int k = 0; k < D; ++k) {
+            int ck = cc[k] + q % 3 - 1;
+            q /= 3;
+            if (ck < 0 || ck >= nc[k]) {
+                if (!w_.domain.periodic[k]) {
+                    ok = false;
+                    break;
+                }
+                ck = (ck + nc[k]) % nc[k];
+            }
+            idx += static_cast<std::uint32_t>(ck) * stride;
+            stride *= static_cast<std::uint32_t>(nc[k]);
+        }
+        if (!ok) continue;
+        std::uint8_t& g = guard_[idx];
+        const std::uint8_t oldLevel = g & 3, newLevel = g >> 2;
+        if (newLevel >= level) continue;
+        if (newLevel == 0) newList_.push_back(idx);
+        g = static_cast<std::uint8_t>(oldLevel | (level << 2));
+        if (level > oldLevel) {  // occupants of a cell that became stricter: watch or hand over
+            edm_->forEachInCell(idx, [&](std::uint32_t i) {
+                if (level >= 2)
+                    arrivals.push_back(i);
+                else
+                    watch_.push_back(i);
+            });
+        }
+    }
+}
+
+template <int D>
+bool HaetEngine<D>::nearTdm(const Vec<D>& x, double r) const {
+    const std::array<int, D> cc = cellCoords(edm_->cellIndex(x));
+    const std::array<int, D>& nc = edm_->cellDims();
+    const Vec<D> L = w_.domain.length();
+    constexpr int m = D == 3 ? 27 : 9;
+    for (int code = 0; code < m; ++code) {
+        std::uint32_t idx = 0, stride = 1;
+        bool ok = true;
+        int q = code;
+        for (int k = 0; k < D; ++k) {
+            int ck = cc[k] + q % 3 - 1;
+            q /= 3;
+            if (ck < 0 || ck >= nc[k]) {
+                if (!w_.domain.periodic[k]) {
+                    ok = false;
+                    break;
+                }
+                ck = (ck + nc[k]) % nc[k];
+            }
+            idx += static_cast<std::uint32_t>(ck) * stride;
+            stride *= static_cast<std::uint32_t>(nc[k]);
+        }
+        if (!ok) continue;
+        for (std::uint32_t b = binHead_[idx]; b != kNil; b = bins_[b].next) {
+            Vec<D> d = x - bins_[b].x;
+            for (int k = 0; k < D; ++k)
+                if (w_.domain.periodic[k]) d[k] -= std::nearbyint(d[k] / L[k]) * L[k];
+            const double reach = r + bins_[b].r + margin_;
+            if (norm2(d) < reach * reach) return true;
+        }
+    }
+    return false;
+}
+
+// Event-driven particles in guard cells: handed over once within reach of a TDM particle.
+template <int D>
+void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals) {
+    std::sort(watch_.begin(), watch_.end());
+    watch_.erase(std::unique(watch_.begin(), watch_.end()), watch_.end());
+    std::size_t keep = 0;
+    for (const std::uint32_t i : watch_) {
+        if (!edm_->owns(i)) continue;
+        const std::uint8_t level = guard_[edm_->cellOfParticle(i)] & 3;
+        if (level == 0) continue;
+        if (level >= 2 || nearTdm(edm_->positionAt(i, w_.time), w_.particles.radius[i])) {
+            arrivals.push_back(i);
+            if (level < 2) ++counters_.nearTdm;
+            continue;
+        }
+        watch_[keep++] = i;
+    }
+    watch_.resize(keep);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// zones and mode changes
+
+template <int D>
+void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals) {
+    ++counters_.relabels;
+    Particles<D>& p = w_.particles;
+    const std::size_t nT = p.tdmCount();
+    const int nz = zones_.count();
+
+    // Zone labels from the volume per zone: the event-driven part is kept current by the engine's crossings.
+    std::vector<double> vol = edm_->zoneVolume();
+    std::vector<int> zoneOf(nT);
+    for (std::size_t i = 0; i < nT; ++i) {
+        zoneOf[i] = zones_.zoneOf(p.x[i]);
+        vol[zoneOf[i]] += Particles<D>::volumeOf(p.radius[i]);
+    }
+    tdm_->contactFlags(contact_);
+    sticky_.assign(nz, 0);
+    for (int z = 0; z < nz; ++z)
+        if (denseUntil_[z] > steps_) sticky_[z] = 1;
+    // A dense zone with a contact stays dense: enduring contacts and particles resting on walls (A.2).
+    for (std::size_t i = 0; i < nT; ++i)
+        if (contact_[i] && zones_.dense(zoneOf[i])) sticky_[zoneOf[i]] = 1;
+    zones_.relabel(vol, sticky_);
+    for (int z = 0; z < nz; ++z)
+        if (zones_.timeDriven(z)) lastTdmStep_[z] = steps_;
+
+    // Candidates to leave the TDM: no contact, zone event-driven for diluteSteps.
+    std::vector<std::uint32_t> candidates;
+    while (!binCells_.empty()) {
+        binHead_[binCells_.back()] = kNil;
+        binCells_.pop_back();
+    }
+    bins_.clear();
+    for (std::size_t i = 0; i < nT; ++i) {
+        const bool dilute = steps_ - lastTdmStep_[zoneOf[i]] >= static_cast<std::uint64_t>(hs_.diluteSteps);
+        if (!frozenModes_ && !contact_[i] && dilute && lastTdmStep_[zoneOf[i]] < steps_)
+            candidates.push_back(static_cast<std::uint32_t>(i));
+        else
+            bin(p.x[i], p.radius[i]);
+    }
+
+    // The new guard: level 2 in time-driven zones, level 1 around the staying TDM particles.
+    newList_.clear();
+    const std::array<int, D>& zd = zones_.dims();
+    for (int z = 0; z < nz; ++z) {
+        if (!zones_.timeDriven(z)) continue;
+        std::array<int, D> zc;
+        int t = z;
+        for (int k = 0; k < D; ++k) {
+            zc[k] = t % zd[k];
+            t /= zd[k];
+        }
+        std::array<std::uint32_t, D> lo, hi, at;
+        bool empty = false;
+        for (int k = 0; k < D; ++k) {
+            lo[k] = zoneCellBegin_[k][zc[k]];
+            hi[k] = zoneCellBegin_[k][zc[k] + 1];
+            empty = empty || lo[k] >= hi[k];
+            at[k] = lo[k];
+        }
+        if (empty) continue;
+        const std::array<int, D>& nc = edm_->cellDims();
+        for (;;) {
+            std::uint32_t idx = 0, stride = 1;
+            for (int k = 0; k < D; ++k) {
+                idx += at[k] * stride;
+                stride *= static_cast<std::uint32_t>(nc[k]);
+            }
+            std::uint8_t& g = guard_[idx];
+            if ((g >> 2) < 2) {
+                if ((g >> 2) == 0) newList_.push_back(idx);
+                if ((g & 3) < 2) edm_->forEachInCell(idx, [&](std::uint32_t i) { arrivals.push_back(i); });
+                g = static_cast<std::uint8_t>((g & 3) | (2 << 2));
+            }
+            int k = 0;
+            while (k < D && ++at[k] == hi[k]) {
+                at[k] = lo[k];
+                ++k;
+            }
+            if (k == D) break;
+        }
+    }
+    for (std::size_t b = 0, nb = binCells_.size(); b < nb; ++b) markAround(binCells_[b], 1, arrivals);
+    // A candidate within reach of a staying TDM particle, or in a time-driven zone's cell, stays too.
+    std::vector<std::uint32_t> departures;
+    for (bool changed = true; changed;) {
+        changed = false;
+        std::size_t keep = 0;
+        for (const std::uint32_t i : candidates) {
+            const std::uint32_t c = edm_->cellIndex(p.x[i]);
+            if ((guard_[c] >> 2) >= 2 || nearTdm(p.x[i], p.radius[i])) {
+                const bool fresh = binHead_[c] == kNil;
+                bin(p.x[i], p.radius[i]);
+                if (fresh) markAround(c, 1, arrivals);
+                changed = true;
+                continue;
+            }
+            candidates[keep++] = i;
+        }
+        candidates.resize(keep);
+    }
+    departures = std::move(candidates);
+    // Settle the guard: new levels replace old ones.
+    for (const std::uint32_t c : guardList_) guard_[c] = static_cast<std::uint8_t>(guard_[c] & ~3u);
+    for (const std::uint32_t c : newList_) guard_[c] = static_cast<std::uint8_t>(guard_[c] >> 2);
+    guardList_.clear();
+    for (const std::uint32_t c : newList_) guardList_.push_back(c);
+    checkWatched(arrivals);
+    if (!arrivals.empty() || !departures.empty()) convert(std::move(arrivals), std::move(departures));
+}
+
+template <int D>
+void HaetEngine<D>::convert(std::vector<std::uint32_t> arrivals, std::vector<std::uint32_t> departures) {
+    Particles<D>& p = w_.particles;
+    const double t = w_.time;
+    std::sort(arrivals.begin(), arrivals.end());
+    arrivals.erase(std::unique(arrivals.begin(), arrivals.end()), arrivals.end());
+    arrivals.erase(std::remove_if(arrivals.begin(), arrivals.end(), [&](std::uint32_t i) { return !edm_->owns(i); }),
+                   arrivals.end());
+    std::sort(departures.begin(), departures.end());
+    departures.erase(std::unique(departures.begin(), departures.end()), departures.end());
+    if (arrivals.empty() && departures.empty()) return;
+
+    std::size_t nT = p.tdmCount();
+    std::vector<std::uint32_t> from(nT);
+    for (std::size_t k = 0; k < nT; ++k) from[k] = static_cast<std::uint32_t>(k);
+    // Where the particles that move end up (watch_ holds World indices): current index -> original index.
+    std::unordered_map<std::uint32_t, std::uint32_t> origin;
+    auto swapAt = [&](std::uint32_t a, std::uint32_t b) {
+        if (a == b) return;
+        p.swapEntries(a, b);
+        edm_->swapIndices(a, b);
+        auto oa = origin.find(a), ob = origin.find(b);
+        const std::uint32_t ia = oa != origin.end() ? oa->second : a, ib = ob != origin.end() ? ob->second : b;
+        origin[a] = ib;
+        origin[b] = ia;
+    };
+    // Event-driven -> time-driven, in increasing index order: each exchanges places with the first EDM particle.
+    for (const std::uint32_t a : arrivals) {
+        edm_->remove(a, t);
+        const double e = particleEnergy(a);
+        tdmIn_ += e;
+        swapAt(a, static_cast<std::uint32_t>(nT));
+        from.push_back(TdmEngine<D>::kFresh);
+        ++nT;
+    }
+    // Time-driven -> event-driven, in decreasing index order: each exchanges places with the last TDM particle.
+    for (auto it = departures.rbegin(); it != departures.rend(); ++it) {
+        const std::uint32_t d = *it;
+        tdmOut_ += particleEnergy(d);
+        const std::uint32_t last = static_cast<std::uint32_t>(nT - 1);
+        swapAt(d, last);
+        from[d] = from[last];
+        from.pop_back();
+        --nT;
+    }
+    p.nTdm = nT;
+    for (std::size_t k = 0; k < departures.size(); ++k) {
+        edm_->add(nT + k, t);
+        watch_.push_back(static_cast<std::uint32_t>(nT + k));
+    }
+    counters_.toTdm += arrivals.size();
+    counters_.toEdm += departures.size();
+    // Watched indices follow their particles.
+    if (!origin.empty() && !watch_.empty()) {
+        std::unordered_map<std::uint32_t, std::uint32_t> now;  // original index -> current index
+        for (const auto& [cur, orig] : origin) now[orig] = cur;
+        for (std::uint32_t& i : watch_) {
+            if (i >= nT && i < nT + departures.size()) continue;  // just added
+            auto f = now.find(i);
+            if (f != now.end()) i = f->second;
+        }
+    }
+    tdm_->remap(from);
+    // The new TDM particles guard their surroundings until the next relabel.
+    std::vector<std::uint32_t> more;
+    for (std::size_t k = 0; k < nT; ++k) {
+        if (from[k] != TdmEngine<D>::kFresh) continue;
+        const std::uint32_t c = edm_->cellIndex(p.x[k]);
+        bin(p.x[k], p.radius[k]);
+        const std::array<int, D> cc = cellCoords(c);
+        const std::array<int, D>& nc = edm_->cellDims();
+        constexpr int m = D == 3 ? 27 : 9;
+        for (int code = 0; code < m; ++code) {
+            std::uint32_t idx = 0, stride = 1;
+            bool ok = true;
+            int q = code;
+            for (int a = 0; a < D; ++a) {
+                int ck = cc[a] + q % 3 - 1;
+                q /= 3;
+                if (ck < 0 || ck >= nc[a]) {
+                    if (!w_.domain.periodic[a]) {
+                        ok = false;
+                        break;
+                    }
+                    ck = (ck + nc[a]) % nc[a];
+                }
+                idx += static_cast<std::uint32_t>(ck) * stride;
+                stride *= static_cast<std::uint32_t>(nc[a]);
+            }
+            if (!ok || guard_[idx] != 0) continue;
+            guard_[idx] = 1;
+            guardList_.push_back(idx);
+            edm_->forEachInCell(idx, [&](std::uint32_t i) { watch_.push_back(i); });
+        }
+    }
+}
+
+template <int D>
+void HaetEngine<D>::forceModes(const std::vector<std::uint32_t>& toTdm, const std::vector<std::uint32_t>& toEdm) {
+    convert(toTdm, toEdm);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// energy
+
+template <int D>
+double HaetEngine<D>::particleEnergy(std::size_t i) const {
+    const Particles<D>& p = w_.particles;
+    double e = -p.mass[i] * dot(w_.domain.gravity, p.x[i] + p.image[i]);
+    if (!p.frozen(i)) e += 0.5 * p.mass[i] * norm2(p.v[i]) + 0.5 * p.inertia(i) * norm2(p.w[i]);
+    return e;
+}
+
+template <int D>
+double HaetEngine<D>::tdmEnergy() const {
+    double e = tdm_->contactEnergy();
+    for (std::size_t i = 0; i < w_.particles.tdmCount(); ++i) e += particleEnergy(i);
+    return e;
+}
+
+template <int D>
+HaetEnergy HaetEngine<D>::energy() const {
+    HaetEnergy e;
+    e.initial = e0_;
+    e.total = tdm_->contactEnergy();
+    for (std::size_t i = 0; i < w_.particles.size(); ++i) e.total += particleEnergy(i);
+    e.dissipatedEdm = edm_->stats().dissipated;
+    e.dissipatedTdm = tdm0_ - tdmEnergy() + tdmIn_ - tdmOut_;
+    e.unaccounted = e.initial - e.total - e.dissipatedTdm - e.dissipatedEdm;
+    return e;
+}
+
+template class HaetEngine<2>;
+template class HaetEngine<3>;
+
+}  // namespace haet

@@ -1,0 +1,129 @@
+#pragma once
+// The hybrid (PHYSICS.md A, docs/haet.md): time-driven DEM where the flow is dense, event-driven dynamics where it
+// is dilute, on one particle store. Particles [0, tdmCount()) are the time-driven engine's, the rest the
+// event-driven engine's; a particle changes mode by exchanging places with the first (or last) particle of the
+// other range, so a mode change costs O(1) in the store plus a pair-list rebuild, never a copy of the system.
+//
+// One step: the event-driven engine processes its events up to the step's end, the time-driven engine takes its
+// step, then particles change mode where the rules say so. The event-driven particles keep their own clocks and
+// are brought to the common time only when they change mode or are written out.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "edm/engine.hpp"
+#include "haet/zones.hpp"
+#include "tdm/engine.hpp"
+#include "world/world.hpp"
+
+namespace haet {
+
+struct HaetSettings {
+    ZoneSettings zones;      ///< zone edge, phi_on / phi_off, buffer (PHYSICS.md A.2)
+    int relabelEvery = 10;   ///< zones are re-labelled every this many steps and at every pair-list rebuild [steps]
+    int diluteSteps = 20;    ///< a time-driven particle without contacts returns to EDM once its zone has been
+                             ///< event-driven this long [steps]
+    double dtMin = 0;        ///< modified EDM (A.4): a collision within dtMin of the particle's previous one hands
+                             ///< both particles to the TDM [s]; 0: the contact duration
+};
+
+/// Where the energy went, since the start [J]. Potential energy is that of gravity, -m g.x (unwrapped x).
+struct HaetEnergy {
+    double initial = 0;        ///< total energy at the start (kinetic + rotational + potential + contacts)
+    double dissipatedTdm = 0;  ///< lost in time-driven contacts (the TDM particles' energy balance)
+    double dissipatedEdm = 0;  ///< lost in event-driven collisions (summed at each collision)
+    double total = 0;          ///< total energy now
+    /// initial - total - dissipatedTdm - dissipatedEdm: what neither engine accounts for (moving walls'
+    /// work, round-off). Zero for static walls, to the accuracy of the time integration.
+    double unaccounted = 0;
+};
+
+struct HaetCounters {
+    std::uint64_t toTdm = 0, toEdm = 0;  ///< mode changes
+    std::uint64_t tcHandovers = 0;       ///< particles handed to the TDM by the modified EDM (A.4)
+    std::uint64_t nearTdm = 0;           ///< event-driven particles that came within reach of a TDM particle
+    std::uint64_t relabels = 0;
+};
+
+template <int D>
+class HaetEngine {
+public:
+    /// Labels the zones, splits the particles and builds both engines at world.time. The time step is the TDM's.
+    HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings edm, const HaetSettings& hs);
+    ~HaetEngine();
+
+    /// One time step of the whole system (events up to its end, one TDM step, mode changes).
+    void step();
+    /// Steps until the time reaches t (to within half a step).
+    void advanceTo(double t);
+    /// Brings the event-driven particles to world.time in the World (for outputs).
+    void synchronise();
+
+    std::size_t nTdm() const { return w_.particles.tdmCount(); }
+    std::size_t nEdm() const { return w_.particles.size() - nTdm(); }
+    std::uint64_t steps() const { return steps_; }
+    std::uint64_t events() const { return edm_->events(); }
+    std::uint64_t collisions() const { return edm_->collisions(); }
+    const HaetCounters& counters() const { return counters_; }
+    /// Energy accounting at world.time (call synchronise() first).
+    HaetEnergy energy() const;
+
+    const TdmEngine<D>& tdm() const { return *tdm_; }
+    const EdmEngine<D>& edm() const { return *edm_; }
+    const ZoneGrid<D>& zones() const { return zones_; }
+    const HaetSettings& settings() const { return hs_; }
+    double dtMin() const { return edm_->tcTime(); }
+    double dt() const { return ts_.dt; }
+
+    /// Sets particle modes by hand (tests): toTdm / toEdm list World indices; rules apply again at the next
+    /// relabel unless freezeModes(true).
+    void forceModes(const std::vector<std::uint32_t>& toTdm, const std::vector<std::uint32_t>& toEdm);
+    /// Switches the automatic mode changes off (tests of a fixed split) or on.
+    void freezeModes(bool on) { frozenModes_ = on; }
+
+private:
+    struct Binned {  // a TDM particle as seen by the guard: position at the last relabel, radius, next in cell
+        Vec<D> x;
+        double r;
+        std::uint32_t next;
+    };
+    void relabel(std::vector<std::uint32_t> arrivals);
+    void checkWatched(std::vector<std::uint32_t>& arrivals);
+    void convert(std::vector<std::uint32_t> arrivals, std::vector<std::uint32_t> departures);
+    void bin(const Vec<D>& x, double r);
+    void markAround(std::uint32_t cell, std::uint8_t level, std::vector<std::uint32_t>& arrivals);
+    bool nearTdm(const Vec<D>& x, double r) const;
+    double particleEnergy(std::size_t i) const;
+    double tdmEnergy() const;
+    std::array<int, D> cellCoords(std::uint32_t c) const;
+
+    World<D>& w_;
+    TdmSettings ts_;
+    HaetSettings hs_;
+    ZoneGrid<D> zones_;
+    std::unique_ptr<EdmEngine<D>> edm_;
+    std::unique_ptr<TdmEngine<D>> tdm_;
+
+    // guard over the event grid: 0 free, 1 near a TDM particle (watched), 2 inside a time-driven zone
+    std::vector<std::uint8_t> guard_;
+    std::vector<std::uint32_t> guardList_, newList_;
+    std::vector<std::uint32_t> binHead_, binCells_;
+    std::vector<Binned> bins_;
+    std::vector<std::uint32_t> watch_;               // event-driven particles in guard cells (World indices)
+    std::array<std::vector<std::uint32_t>, D> zoneCellBegin_;  // per axis and zone coordinate: first cell coordinate
+    std::vector<std::uint64_t> lastTdmStep_;  // per zone: last step it was time-driven
+    std::vector<std::uint64_t> denseUntil_;   // per zone: kept dense until this step (modified EDM hand-over)
+    std::vector<std::uint8_t> sticky_, contact_;
+    double margin_ = 0;  // distance at which an event-driven particle counts as near a TDM one [m]
+
+    std::uint64_t steps_ = 0;
+    bool frozenModes_ = false;
+    HaetCounters counters_;
+    double e0_ = 0, tdmIn_ = 0, tdmOut_ = 0, tdm0_ = 0;
+};
+
+extern template class HaetEngine<2>;
+extern template class HaetEngine<3>;
+
+}  // namespace haet
