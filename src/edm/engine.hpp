@@ -121,6 +121,8 @@ public:
     std::vector<std::uint32_t> takeTcHandovers();
     /// Position of owned particle i at time t (>= its clock), wrapped into the box [m].
     Vec<D> positionAt(std::size_t i, double t) const;
+    /// Velocity of owned particle i at time t [m/s].
+    Vec<D> velocityAt(std::size_t i, double t) const { return velAt(hot_[slotOf_[i]], t); }
     /// Guard value of the cell particle i is in.
     std::uint32_t cellOfParticle(std::size_t i) const { return rec_[slotOf_[i]].cell; }
     /// The event grid, for the hybrid's guard.

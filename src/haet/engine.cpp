@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -86,7 +87,7 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
     for (std::size_t i = 0; i < n; ++i) e0_ += particleEnergy(i);
     e0_ += tdm_->contactEnergy();
     tdm0_ = tdmEnergy();
-    relabel({});
+    relabel({}, true);
 }
 
 template <int D>
@@ -108,22 +109,19 @@ void HaetEngine<D>::step() {
         ++counters_.tcHandovers;
         denseUntil_[zones_.zoneOf(edm_->positionAt(i, w_.time))] = steps_ + hs_.diluteSteps + hs_.relabelEvery;
     }
-    for (const std::uint32_t i : edm_->takeGuardEntries()) {
-        if (frozenModes_ || !edm_->owns(i)) continue;
-        const std::uint8_t level = guard_[edm_->cellOfParticle(i)];
-        if (level >= 2)
-            arrivals.push_back(i);
-        else if (level == 1)
-            watch_.push_back(i);
-    }
+    for (const std::uint32_t i : edm_->takeGuardEntries())
+        if (!frozenModes_ && edm_->owns(i) && guard_[edm_->cellOfParticle(i)] != 0) watch_.push_back(i);
     if (frozenModes_) return;
-    checkWatched(arrivals);
-    // TDM particles move less than skin/2 between pair-list builds: relabelling at each build keeps the guard's
-    // picture of them within that distance.
-    if (steps_ % static_cast<std::uint64_t>(hs_.relabelEvery) == 0 || tdm_->rebuilds() != rebuilds)
-        relabel(std::move(arrivals));
-    else if (!arrivals.empty())
-        convert(std::move(arrivals), {});
+    // Mode changes wait for every relabelEvery-th step (each costs a pair-list rebuild), unless a particle would
+    // touch a TDM particle before then. TDM particles move less than skin/2 between pair-list builds: relabelling
+    // at each build too keeps the guard's picture of them within that distance.
+    const bool due = steps_ % static_cast<std::uint64_t>(hs_.relabelEvery) == 0;
+    if (due || tdm_->rebuilds() != rebuilds) {
+        relabel(std::move(arrivals), due);
+        return;
+    }
+    checkWatched(arrivals, false);
+    if (!arrivals.empty()) convert(std::move(arrivals), {});
 }
 
 template <int D>
@@ -187,19 +185,14 @@ void HaetEngine<D>::markAround(std::uint32_t cell, std::uint8_t level, std::vect
         if (newLevel >= level) continue;
         if (newLevel == 0) newList_.push_back(idx);
         g = static_cast<std::uint8_t>(oldLevel | (level << 2));
-        if (level > oldLevel) {  // occupants of a cell that became stricter: watch or hand over
-            edm_->forEachInCell(idx, [&](std::uint32_t i) {
-                if (level >= 2)
-                    arrivals.push_back(i);
-                else
-                    watch_.push_back(i);
-            });
-        }
+        if (level > oldLevel)  // occupants of a cell that became stricter are watched
+            edm_->forEachInCell(idx, [&](std::uint32_t i) { watch_.push_back(i); });
     }
 }
 
 template <int D>
-bool HaetEngine<D>::nearTdm(const Vec<D>& x, double r) const {
+double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r) const {
+    double gap = kNever;
     const std::array<int, D> cc = cellCoords(edm_->cellIndex(x));
     const std::array<int, D>& nc = edm_->cellDims();
     const Vec<D> L = w_.domain.length();
@@ -226,27 +219,34 @@ bool HaetEngine<D>::nearTdm(const Vec<D>& x, double r) const {
             Vec<D> d = x - bins_[b].x;
             for (int k = 0; k < D; ++k)
                 if (w_.domain.periodic[k]) d[k] -= std::nearbyint(d[k] / L[k]) * L[k];
-            const double reach = r + bins_[b].r + margin_;
-            if (norm2(d) < reach * reach) return true;
+            const double reach = r + bins_[b].r + margin_, d2 = norm2(d);
+            if (d2 < reach * reach && d2 > 0) gap = std::min(gap, std::sqrt(d2) - r - bins_[b].r);
         }
     }
-    return false;
+    return gap;
 }
 
-// Event-driven particles in guard cells: handed over once within reach of a TDM particle.
+// Event-driven particles in guard cells: handed over once within reach of a TDM particle or inside a time-driven
+// zone; before the next due step only if they could touch a TDM particle before it.
 template <int D>
-void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals) {
+void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals, bool due) {
     std::sort(watch_.begin(), watch_.end());
     watch_.erase(std::unique(watch_.begin(), watch_.end()), watch_.end());
+    const std::uint64_t R = static_cast<std::uint64_t>(hs_.relabelEvery);
+    const double horizon = ts_.dt * static_cast<double>(R - steps_ % R + 1);
     std::size_t keep = 0;
     for (const std::uint32_t i : watch_) {
         if (!edm_->owns(i)) continue;
         const std::uint8_t level = guard_[edm_->cellOfParticle(i)] & 3;
         if (level == 0) continue;
-        if (level >= 2 || nearTdm(edm_->positionAt(i, w_.time), w_.particles.radius[i])) {
-            arrivals.push_back(i);
-            if (level < 2) ++counters_.nearTdm;
-            continue;
+        const double gap = gapToTdm(edm_->positionAt(i, w_.time), w_.particles.radius[i]);
+        if (level >= 2 || gap < margin_) {
+            const double reach = (norm(edm_->velocityAt(i, w_.time)) + vTdmMax_) * horizon;
+            if (due || gap < reach) {
+                arrivals.push_back(i);
+                if (level < 2) ++counters_.nearTdm;
+                continue;
+            }
         }
         watch_[keep++] = i;
     }
@@ -257,7 +257,7 @@ void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals) {
 // zones and mode changes
 
 template <int D>
-void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals) {
+void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
     ++counters_.relabels;
     Particles<D>& p = w_.particles;
     const std::size_t nT = p.tdmCount();
@@ -266,31 +266,41 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals) {
     // Zone labels from the volume per zone: the event-driven part is kept current by the engine's crossings.
     std::vector<double> vol = edm_->zoneVolume();
     std::vector<int> zoneOf(nT);
+    double v2 = 0;
     for (std::size_t i = 0; i < nT; ++i) {
         zoneOf[i] = zones_.zoneOf(p.x[i]);
         vol[zoneOf[i]] += Particles<D>::volumeOf(p.radius[i]);
+        if (!p.frozen(i)) v2 = std::max(v2, norm2(p.v[i]));
     }
-    tdm_->contactFlags(contact_);
+    vTdmMax_ = std::sqrt(v2);
+    tdm_->contactCounts(contact_);
     sticky_.assign(nz, 0);
     for (int z = 0; z < nz; ++z)
         if (denseUntil_[z] > steps_) sticky_[z] = 1;
-    // A dense zone with a contact stays dense: enduring contacts and particles resting on walls (A.2).
+    // Contacts keep a zone dense, and make it dense where a particle rests on a wall or touches two others: the
+    // smoothed fraction misses a packing thinner than about two zones, such as a bed of a few layers (A.2,
+    // docs/haet.md). A single pair contact (a binary collision) only keeps a dense zone dense.
     for (std::size_t i = 0; i < nT; ++i)
-        if (contact_[i] && zones_.dense(zoneOf[i])) sticky_[zoneOf[i]] = 1;
+        if (contact_[i] >= 2 || (contact_[i] == 1 && zones_.dense(zoneOf[i]))) sticky_[zoneOf[i]] = 1;
     zones_.relabel(vol, sticky_);
     for (int z = 0; z < nz; ++z)
         if (zones_.timeDriven(z)) lastTdmStep_[z] = steps_;
 
-    // Candidates to leave the TDM: no contact, zone event-driven for diluteSteps.
-    std::vector<std::uint32_t> candidates;
+    // Leaving the TDM: no contact, the zone event-driven for diluteSteps and its own (unsmoothed) fraction below
+    // phi_off (a loose packing whose particles happen not to touch at this instant stays), and no staying TDM
+    // particle within the margin: the particles of a dilute cluster leave together (A.3, docs/haet.md).
     while (!binCells_.empty()) {
         binHead_[binCells_.back()] = kNil;
         binCells_.pop_back();
     }
     bins_.clear();
+    std::vector<std::uint32_t> candidates;
     for (std::size_t i = 0; i < nT; ++i) {
-        const bool dilute = steps_ - lastTdmStep_[zoneOf[i]] >= static_cast<std::uint64_t>(hs_.diluteSteps);
-        if (!frozenModes_ && !contact_[i] && dilute && lastTdmStep_[zoneOf[i]] < steps_)
+        const std::uint64_t last = lastTdmStep_[zoneOf[i]];
+        const bool leave = due && !frozenModes_ && !contact_[i] && last < steps_ &&
+                           steps_ - last >= static_cast<std::uint64_t>(hs_.diluteSteps) &&
+                           zones_.fraction(zoneOf[i]) < hs_.zones.phiOff;
+        if (leave)
             candidates.push_back(static_cast<std::uint32_t>(i));
         else
             bin(p.x[i], p.radius[i]);
@@ -326,7 +336,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals) {
             std::uint8_t& g = guard_[idx];
             if ((g >> 2) < 2) {
                 if ((g >> 2) == 0) newList_.push_back(idx);
-                if ((g & 3) < 2) edm_->forEachInCell(idx, [&](std::uint32_t i) { arrivals.push_back(i); });
+                if ((g & 3) < 2) edm_->forEachInCell(idx, [&](std::uint32_t i) { watch_.push_back(i); });
                 g = static_cast<std::uint8_t>((g & 3) | (2 << 2));
             }
             int k = 0;
@@ -338,14 +348,15 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals) {
         }
     }
     for (std::size_t b = 0, nb = binCells_.size(); b < nb; ++b) markAround(binCells_[b], 1, arrivals);
-    // A candidate within reach of a staying TDM particle, or in a time-driven zone's cell, stays too.
+    // A candidate within reach of a staying TDM particle, or whose event-grid cell belongs to a time-driven zone,
+    // stays (it would be handed back at once); so may its neighbours then.
     std::vector<std::uint32_t> departures;
     for (bool changed = true; changed;) {
         changed = false;
         std::size_t keep = 0;
         for (const std::uint32_t i : candidates) {
             const std::uint32_t c = edm_->cellIndex(p.x[i]);
-            if ((guard_[c] >> 2) >= 2 || nearTdm(p.x[i], p.radius[i])) {
+            if ((guard_[c] >> 2) >= 2 || gapToTdm(p.x[i], p.radius[i]) < margin_) {
                 const bool fresh = binHead_[c] == kNil;
                 bin(p.x[i], p.radius[i]);
                 if (fresh) markAround(c, 1, arrivals);
@@ -362,7 +373,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals) {
     for (const std::uint32_t c : newList_) guard_[c] = static_cast<std::uint8_t>(guard_[c] >> 2);
     guardList_.clear();
     for (const std::uint32_t c : newList_) guardList_.push_back(c);
-    checkWatched(arrivals);
+    checkWatched(arrivals, due);
     if (!arrivals.empty() || !departures.empty()) convert(std::move(arrivals), std::move(departures));
 }
 

@@ -88,12 +88,15 @@ private:
         double r;
         std::uint32_t next;
     };
-    void relabel(std::vector<std::uint32_t> arrivals);
-    void checkWatched(std::vector<std::uint32_t>& arrivals);
+    /// Zones, guard and bins from the current state; mode changes on due steps (and urgent ones always).
+    void relabel(std::vector<std::uint32_t> arrivals, bool due);
+    void checkWatched(std::vector<std::uint32_t>& arrivals, bool due);
     void convert(std::vector<std::uint32_t> arrivals, std::vector<std::uint32_t> departures);
     void bin(const Vec<D>& x, double r);
     void markAround(std::uint32_t cell, std::uint8_t level, std::vector<std::uint32_t>& arrivals);
-    bool nearTdm(const Vec<D>& x, double r) const;
+    /// Smallest gap between a sphere (x, r) and the binned TDM particles within the margin (one at x itself
+    /// excluded); infinity if none.
+    double gapToTdm(const Vec<D>& x, double r) const;
     double particleEnergy(std::size_t i) const;
     double tdmEnergy() const;
     std::array<int, D> cellCoords(std::uint32_t c) const;
@@ -116,6 +119,7 @@ private:
     std::vector<std::uint64_t> denseUntil_;   // per zone: kept dense until this step (modified EDM hand-over)
     std::vector<std::uint8_t> sticky_, contact_;
     double margin_ = 0;  // distance at which an event-driven particle counts as near a TDM one [m]
+    double vTdmMax_ = 0; // fastest TDM particle at the last relabel [m/s]
 
     std::uint64_t steps_ = 0;
     bool frozenModes_ = false;

@@ -131,20 +131,23 @@ void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
 }
 
 template <int D>
-void TdmEngine<D>::contactFlags(std::vector<std::uint8_t>& out) const {
+void TdmEngine<D>::contactCounts(std::vector<std::uint8_t>& out) const {
     const Particles<D>& p = w_.particles;
     const std::size_t n = p.tdmCount();
     out.assign(n, 0);
+    auto bump = [](std::uint8_t& c, int k) { c = static_cast<std::uint8_t>(std::min(255, c + k)); };
     for (std::size_t i = 0; i < n; ++i) {
         for (std::uint32_t k = pairs_.first[i]; k < pairs_.first[i + 1]; ++k) {
             const std::uint32_t j = pairs_.partner[k];
             const Vec<D> d = p.x[i] - p.x[j] + pairs_.shiftVec[pairs_.shift[k]];
             const double rs = p.radius[i] + p.radius[j];
-            if (norm2(d) < rs * rs) out[i] = out[j] = 1;
+            if (norm2(d) < rs * rs) {
+                bump(out[i], 1);
+                bump(out[j], 1);
+            }
         }
-        if (out[i]) continue;
         for (const Wall<D>& wall : w_.walls)
-            if (wall.distance(p.x[i], w_.time) < p.radius[i]) out[i] = 1;
+            if (wall.distance(p.x[i], w_.time) < p.radius[i]) bump(out[i], 2);
     }
 }
 

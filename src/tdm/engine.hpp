@@ -44,8 +44,9 @@ public:
     /// flight); the pair list is rebuilt. Call at a step boundary.
     static constexpr std::uint32_t kFresh = 0xFFFFFFFFu;
     void remap(const std::vector<std::uint32_t>& from);
-    /// out[i] = 1 if particle i touches another particle or a wall at the current positions (i < tdmCount()).
-    void contactFlags(std::vector<std::uint8_t>& out) const;
+    /// out[i]: contacts of particle i at the current positions, a wall contact counting 2 (resting on a wall
+    /// weighs like two neighbours); saturates at 255. For i < tdmCount().
+    void contactCounts(std::vector<std::uint8_t>& out) const;
 
     /// Elastic energy stored in contacts (pairs and walls) [J].
     double contactEnergy() const;
