@@ -25,8 +25,8 @@ validate: build
 	cd $(BUILD) && ctest -L validate --output-on-failure -j $(JOBS)
 
 demo: build
-	$(BUILD)/haet run examples/box2d_settle.toml --out runs/demo
-	@echo "demo: outputs in runs/demo (final.png, series.csv, particles.pvd, run.json)"
+	$(BUILD)/haet run examples/haet_demo.toml --out runs/demo
+	@echo "demo: runs/demo/final.png (blue: time-driven, orange: event-driven), series.csv, particles.pvd, zones.pvd, run.json"
 
 bench: build
 	bench/run_all.sh $(BUILD)

@@ -1,9 +1,11 @@
-// The `haet` command line: run and check scenarios. Exit codes: 0 ok, 2 bad input, 3 simulation blew up.
+// The `haet` command line: run and check scenarios, plot CSV tables. Exit codes: 0 ok, 2 bad input, 3 simulation blew up.
 #include <CLI/CLI.hpp>
 #include <iostream>
 
 #include "core/version.hpp"
 #include "io/atomic_file.hpp"
+#include "io/png.hpp"
+#include "io/table.hpp"
 #include "run/runner.hpp"
 #include "scenario/loader.hpp"
 
@@ -25,6 +27,18 @@ int main(int argc, char** argv) {
     auto* check = app.add_subcommand("check", "validate a scenario and print what it would run");
     check->add_option("scenario", checkFile, "scenario file (TOML)")->required();
 
+    std::string plotFile, plotOut, plotX = "time", plotTitle;
+    std::vector<std::string> plotY;
+    bool logX = false, logY = false;
+    auto* plot = app.add_subcommand("plot", "plot columns of a CSV file (series.csv, benchmark tables) as a PNG");
+    plot->add_option("csv", plotFile, "CSV file with a header row")->required();
+    plot->add_option("-x,--x", plotX, "column on the x axis (default: time)");
+    plot->add_option("-y,--y", plotY, "columns on the y axis")->required();
+    plot->add_option("-o,--out", plotOut, "PNG file to write")->required();
+    plot->add_option("--title", plotTitle, "title (default: the file name)");
+    plot->add_flag("--logx", logX, "logarithmic x axis");
+    plot->add_flag("--logy", logY, "logarithmic y axis");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -38,11 +52,34 @@ int main(int argc, char** argv) {
             haet::RunOptions opt{outDir, threads, quiet};
             return static_cast<int>(haet::runScenario(sc, opt, std::cerr));
         }
+        if (*plot) {
+            const haet::CsvTable t = haet::readCsvTable(plotFile);
+            auto col = [&](const std::string& name) {
+                const int c = t.column(name);
+                if (c < 0) throw std::invalid_argument(plotFile + ": no column '" + name + "'");
+                return t.values(c);
+            };
+            const std::uint32_t colours[] = {0x1f77b4, 0xd62728, 0x2ca02c, 0xff7f0e, 0x9467bd, 0x8c564b};
+            std::vector<haet::PlotSeries> series;
+            const std::vector<double> x = col(plotX);
+            for (std::size_t k = 0; k < plotY.size(); ++k)
+                series.push_back({plotY[k], x, col(plotY[k]), colours[k % 6]});
+            haet::LinePlotOptions o;
+            o.logX = logX;
+            o.logY = logY;
+            o.markers = t.rows.size() <= 60;
+            haet::writeLinePlotPng(plotOut, plotTitle.empty() ? plotFile : plotTitle, plotX,
+                                   plotY.size() == 1 ? plotY[0] : std::string(), series, o);
+            return 0;
+        }
         const haet::Scenario sc = haet::loadScenario(checkFile);
         haet::describeScenario(sc, std::cout);
         std::cout << "ok\n";
         return 0;
     } catch (const haet::ScenarioError& e) {
+        std::cerr << "error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::invalid_argument& e) {
         std::cerr << "error: " << e.what() << "\n";
         return 2;
     } catch (const haet::IoError& e) {

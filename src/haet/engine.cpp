@@ -55,7 +55,7 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
     // The event grid's cells hold one particle diameter plus the TDM skin: a particle in a cell next to a TDM
     // particle's cell is at least a skin's width from touching it (docs/haet.md).
     edm.firstParticle = nT;
-    if (hs_.dtMin > 0) edm.tcTime = hs_.dtMin;
+    edm.tcTime = hs_.dtMin > 0 ? hs_.dtMin : w_.contact.contactTime;
     edm.tcModel = true;
     edm.cellSize = std::max(edm.cellSize, 2 * rmax + ts_.skin);
     edm_ = std::make_unique<EdmEngine<D>>(w_, edm);

@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# The hybrid against the single methods (issue: HAET performance), one thread, one run after the other.
+#
+#   bench/haet_compare.sh BUILD_DIR [OUT_DIR]
+#
+# 1. The flagship demo examples/haet_demo.toml (or $DEMO) run three ways, method = "tdm", "edm" and "haet", same
+#    physics and simulated time. Prints CPU time (user + sys) and wall time of each and the ratios TDM / HAET and
+#    EDM / HAET, and the bound N_total / N_dense (time average of n_tdm in the hybrid's series.csv).
+# 2. The dilute-fraction sweep: bench/haet_sweep.toml with a bed of (1 - f) N disks and a falling cloud of f N that
+#    does not reach the bed within the run, for f in $FRACTIONS; TDM and HAET each. Writes OUT_DIR/haet_sweep.csv
+#    (fraction, measured mean event-driven fraction, CPU times, speed-up, bound) and OUT_DIR/haet_sweep.png.
+#
+# CPU times, not wall times, are compared: the machines are shared. OUT_DIR defaults to runs/bench.
+set -euo pipefail
+
+[ $# -ge 1 ] || { echo "usage: $0 BUILD_DIR [OUT_DIR]" >&2; exit 2; }
+build=$(cd "$1" && pwd)
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+root=$(cd "$here/.." && pwd)
+out=${2:-$root/runs/bench}
+mkdir -p "$out"
+haet="$build/haet"
+demo=${DEMO:-$root/examples/haet_demo.toml}
+N=${SWEEP_N:-4000}
+FRACTIONS=${FRACTIONS:-"0.5 0.75 0.9 0.95"}
+[ -x /usr/bin/time ] || { echo "$0: needs /usr/bin/time (Debian package time)" >&2; exit 1; }
+
+# run NAME SCENARIO: runs one scenario on one thread; sets CPU (s) and WALL (s).
+run() {
+    local name=$1 scenario=$2
+    /usr/bin/time -f "%U %S %e" -o "$out/$name.time" "$haet" run "$scenario" --out "$out/$name" --threads 1 --quiet
+    read -r user sys wall <"$out/$name.time"
+    CPU=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.2f", u + s }')
+    WALL=$wall
+}
+
+# mean of column COL of a series.csv
+mean_col() { awk -F, -v name="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i; next }
+    { s += $c; n++ } END { printf "%.6g", s / n }' "$1"; }
+
+echo "--- demo: $(basename "$demo"), one thread"
+declare -A cpu
+for m in tdm edm haet; do
+    sed "s/^method = .*/method = \"$m\"/" "$demo" >"$out/demo_$m.toml"
+    if run "demo_$m" "$out/demo_$m.toml"; then
+        cpu[$m]=$CPU
+        printf "%-5s CPU %8.2f s   wall %8.2f s\n" "$m" "$CPU" "$WALL"
+    else
+        cpu[$m]=""
+        echo "$m: run failed (see $out/demo_$m)"
+    fi
+done
+n_total=$(mean_col "$out/demo_haet/series.csv" n_particles)
+n_dense=$(mean_col "$out/demo_haet/series.csv" n_tdm)
+awk -v t="${cpu[tdm]}" -v e="${cpu[edm]}" -v h="${cpu[haet]}" -v n="$n_total" -v d="$n_dense" 'BEGIN {
+    if (t != "" && h > 0) printf "speed-up TDM / HAET: %.2f\n", t / h;
+    if (e != "" && h > 0) printf "ratio    EDM / HAET: %.2f\n", e / h;
+    printf "bound N_total / N_dense (time average): %.2f (N_dense = %.0f of %.0f)\n", n / d, d, n }'
+
+echo "--- sweep: N = $N, fractions $FRACTIONS"
+csv="$out/haet_sweep.csv"
+echo "fraction,edm_fraction,cpu_tdm,cpu_haet,speedup,bound" >"$csv.tmp"
+for f in $FRACTIONS; do
+    rain=$(awk -v n="$N" -v f="$f" 'BEGIN { printf "%d", n * f + 0.5 }')
+    bed=$((N - rain))
+    for m in tdm haet; do
+        sed "s/@BED@/$bed/; s/@RAIN@/$rain/; s/@METHOD@/$m/" "$here/haet_sweep.toml" >"$out/sweep_${f}_$m.toml"
+        run "sweep_${f}_$m" "$out/sweep_${f}_$m.toml"
+        cpu[$m]=$CPU
+    done
+    series="$out/sweep_${f}_haet/series.csv"
+    ef=$(awk -v e="$(mean_col "$series" n_edm)" -v n="$N" 'BEGIN { printf "%.4f", e / n }')
+    bound=$(awk -v d="$(mean_col "$series" n_tdm)" -v n="$N" 'BEGIN { printf "%.3f", n / d }')
+    speedup=$(awk -v t="${cpu[tdm]}" -v h="${cpu[haet]}" 'BEGIN { printf "%.3f", t / h }')
+    echo "$f,$ef,${cpu[tdm]},${cpu[haet]},$speedup,$bound" >>"$csv.tmp"
+    printf "f = %-5s event-driven %.3f   TDM %7.2f s   HAET %7.2f s   speed-up %6.2f   bound %6.2f\n" \
+        "$f" "$ef" "${cpu[tdm]}" "${cpu[haet]}" "$speedup" "$bound"
+done
+mv "$csv.tmp" "$csv"
+"$haet" plot "$csv" -x edm_fraction -y speedup -y bound --logy --title "HAET speed-up over TDM against the event-driven fraction" \
+    -o "$out/haet_sweep.png"
+echo "wrote $csv and $out/haet_sweep.png"
