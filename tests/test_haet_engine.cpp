@@ -33,7 +33,7 @@ World<D> pairWorld(double ratio) {
     Scenario sc = testing::linearScenario(D, 0.9, kTc, 0.5, TangentialLaw::Spring);
     sc.materials[0].tangentialRestitution = 0.99787;
     World<D> w;
-    w.domain = testing::openBox<D>(1.0);
+    w.domain = testing::openBox<D>(0.2);
     Vec<D> n = Vec<D>::zero(), t = Vec<D>::zero();
     n[D - 1] = 1;
     t[0] = 1;

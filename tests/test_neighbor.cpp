@@ -94,5 +94,69 @@ TEST(Neighbor, HistorySurvivesRebuildAndPermutation) {
     EXPECT_GT(checked, 100u);
 }
 
+/// The incremental update of a hybrid mode change against a full build: particles leave (the last TDM particle
+/// takes a leaver's place) and new ones join at the end; the pairs must be those of a fresh build, and the history
+/// of kept pairs must follow its particles.
+template <int D>
+void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed) {
+    Domain<D> dom;
+    dom.lo = Vec<D>::zero();
+    dom.hi = Vec<D>::filled(1.0);
+    dom.periodic = periodic;
+    auto all = randomParticles<D>(D == 2 ? 1200 : 1500, dom, 0.01, 0.04, seed);
+    const std::size_t n0 = all.size() - 100;  // the last 100 are outside the list at first
+    all.nTdm = n0;
+    NeighborSettings s{0.02, true};
+    PairList<D> list;
+    buildPairList(all, dom, s, PairList<D>{}, list);
+    for (std::size_t i = 0; i < n0; ++i)
+        for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k)
+            list.history[k] = Vec<D>::filled(double(all.id[i]) * 10000 + double(all.id[list.partner[k]]));
+    // 60 leave (every 17th), 100 join.
+    std::vector<std::uint32_t> from(n0);
+    for (std::size_t k = 0; k < n0; ++k) from[k] = static_cast<std::uint32_t>(k);
+    std::size_t nT = n0;
+    for (std::size_t d = 17 * 59; ; d -= 17) {
+        all.swapEntries(d, nT - 1);
+        from[d] = from[nT - 1];
+        from.pop_back();
+        --nT;
+        if (d == 0) break;
+    }
+    // the leavers now sit at [nT, n0); bring the 100 outsiders in front of them
+    for (std::size_t k = 0; k < 100; ++k) {
+        all.swapEntries(n0 + k, nT);
+        from.push_back(0xFFFFFFFFu);
+        ++nT;
+    }
+    all.nTdm = nT;
+    remapPairList(all, dom, s, from, list);
+    PairList<D> ref;
+    buildPairList(all, dom, s, PairList<D>{}, ref);
+    EXPECT_EQ(pairSet(list), pairSet(ref));
+    EXPECT_EQ(list.pairT.size(), list.size());
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < nT; ++i)
+        for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
+            const double h = list.history[k][0];
+            if (h == 0) continue;  // a pair with a new particle
+            const double a = double(all.id[i]) * 10000 + double(all.id[list.partner[k]]);
+            const double b = double(all.id[list.partner[k]]) * 10000 + double(all.id[i]);
+            EXPECT_TRUE(h == a || h == -b) << "pair " << all.id[i] << "-" << all.id[list.partner[k]];
+            ++kept;
+        }
+    EXPECT_GT(kept, 100u);
+}
+
+TEST(Neighbor, RemapAfterModeChangeMatchesBuild3D) {
+    remapMatchesBuild<3>({true, true, true}, 21);
+    remapMatchesBuild<3>({false, true, false}, 22);
+}
+
+TEST(Neighbor, RemapAfterModeChangeMatchesBuild2D) {
+    remapMatchesBuild<2>({true, true}, 23);
+    remapMatchesBuild<2>({false, false}, 24);
+}
+
 }  // namespace
 }  // namespace haet

@@ -258,33 +258,38 @@ void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals, bool due)
 
 template <int D>
 void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
-    ++counters_.relabels;
     Particles<D>& p = w_.particles;
     const std::size_t nT = p.tdmCount();
     const int nz = zones_.count();
 
-    // Zone labels from the volume per zone: the event-driven part is kept current by the engine's crossings.
-    std::vector<double> vol = edm_->zoneVolume();
-    std::vector<int> zoneOf(nT);
     double v2 = 0;
-    for (std::size_t i = 0; i < nT; ++i) {
-        zoneOf[i] = zones_.zoneOf(p.x[i]);
-        vol[zoneOf[i]] += Particles<D>::volumeOf(p.radius[i]);
-        if (!p.frozen(i)) v2 = std::max(v2, norm2(p.v[i]));
-    }
-    vTdmMax_ = std::sqrt(v2);
-    tdm_->contactCounts(contact_);
-    sticky_.assign(nz, 0);
-    for (int z = 0; z < nz; ++z)
-        if (denseUntil_[z] > steps_) sticky_[z] = 1;
-    // Contacts keep a zone dense, and make it dense where a particle rests on a wall or touches two others: the
-    // smoothed fraction misses a packing thinner than about two zones, such as a bed of a few layers (A.2,
-    // docs/haet.md). A single pair contact (a binary collision) only keeps a dense zone dense.
     for (std::size_t i = 0; i < nT; ++i)
-        if (contact_[i] >= 2 || (contact_[i] == 1 && zones_.dense(zoneOf[i]))) sticky_[zoneOf[i]] = 1;
-    zones_.relabel(vol, sticky_);
-    for (int z = 0; z < nz; ++z)
-        if (zones_.timeDriven(z)) lastTdmStep_[z] = steps_;
+        if (!p.frozen(i)) v2 = std::max(v2, norm2(p.v[i]));
+    vTdmMax_ = std::sqrt(v2);
+    // Zone labels (due steps only) from the volume per zone: the event-driven part is kept current by the
+    // engine's crossings.
+    std::vector<int> zoneOf;
+    if (due) {
+        ++counters_.relabels;
+        std::vector<double> vol = edm_->zoneVolume();
+        zoneOf.resize(nT);
+        for (std::size_t i = 0; i < nT; ++i) {
+            zoneOf[i] = zones_.zoneOf(p.x[i]);
+            vol[zoneOf[i]] += Particles<D>::volumeOf(p.radius[i]);
+        }
+        tdm_->contactCounts(contact_);
+        sticky_.assign(nz, 0);
+        for (int z = 0; z < nz; ++z)
+            if (denseUntil_[z] > steps_) sticky_[z] = 1;
+        // Contacts keep a zone dense, and make it dense where a particle rests on a wall or touches two others:
+        // the smoothed fraction misses a packing thinner than about two zones, such as a bed of a few layers
+        // (A.2, docs/haet.md). A single pair contact (a binary collision) only keeps a dense zone dense.
+        for (std::size_t i = 0; i < nT; ++i)
+            if (contact_[i] >= 2 || (contact_[i] == 1 && zones_.dense(zoneOf[i]))) sticky_[zoneOf[i]] = 1;
+        zones_.relabel(vol, sticky_);
+        for (int z = 0; z < nz; ++z)
+            if (zones_.timeDriven(z)) lastTdmStep_[z] = steps_;
+    }
 
     // Leaving the TDM: no contact, the zone event-driven for diluteSteps and its own (unsmoothed) fraction below
     // phi_off (a loose packing whose particles happen not to touch at this instant stays), and no staying TDM
@@ -296,7 +301,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
     bins_.clear();
     std::vector<std::uint32_t> candidates;
     for (std::size_t i = 0; i < nT; ++i) {
-        const std::uint64_t last = lastTdmStep_[zoneOf[i]];
+        const std::uint64_t last = due ? lastTdmStep_[zoneOf[i]] : steps_;
         const bool leave = due && !frozenModes_ && !contact_[i] && last < steps_ &&
                            steps_ - last >= static_cast<std::uint64_t>(hs_.diluteSteps) &&
                            zones_.fraction(zoneOf[i]) < hs_.zones.phiOff;

@@ -21,7 +21,8 @@ namespace haet {
 
 struct HaetSettings {
     ZoneSettings zones;      ///< zone edge, phi_on / phi_off, buffer (PHYSICS.md A.2)
-    int relabelEvery = 10;   ///< zones are re-labelled every this many steps and at every pair-list rebuild [steps]
+    int relabelEvery = 50;   ///< zones are re-labelled, and particles change mode, every this many steps [steps];
+                             ///< the guard follows the TDM particles at every pair-list build
     int diluteSteps = 20;    ///< a time-driven particle without contacts returns to EDM once its zone has been
                              ///< event-driven this long [steps]
     double dtMin = 0;        ///< modified EDM (A.4): a collision within dtMin of the particle's previous one hands
@@ -43,7 +44,7 @@ struct HaetCounters {
     std::uint64_t toTdm = 0, toEdm = 0;  ///< mode changes
     std::uint64_t tcHandovers = 0;       ///< particles handed to the TDM by the modified EDM (A.4)
     std::uint64_t nearTdm = 0;           ///< event-driven particles that came within reach of a TDM particle
-    std::uint64_t relabels = 0;
+    std::uint64_t relabels = 0;          ///< zone relabellings
 };
 
 template <int D>
@@ -88,7 +89,8 @@ private:
         double r;
         std::uint32_t next;
     };
-    /// Zones, guard and bins from the current state; mode changes on due steps (and urgent ones always).
+    /// The guard and bins from the current TDM positions; on due steps also the zone labels and the mode changes
+    /// they imply (urgent hand-overs always).
     void relabel(std::vector<std::uint32_t> arrivals, bool due);
     void checkWatched(std::vector<std::uint32_t>& arrivals, bool due);
     void convert(std::vector<std::uint32_t> arrivals, std::vector<std::uint32_t> departures);

@@ -97,6 +97,18 @@ inline bool testPair(const Particles<D>& p, const Domain<D>& dom, const Neighbor
     return true;
 }
 
+/// Transposed index, in increasing pair order for each partner (deterministic gather order).
+template <int D>
+void buildTransposed(std::size_t n, PairList<D>& out) {
+    const std::size_t np = out.partner.size();
+    out.firstT.assign(n + 1, 0);
+    for (std::size_t k = 0; k < np; ++k) ++out.firstT[out.partner[k] + 1];
+    for (std::size_t i = 0; i < n; ++i) out.firstT[i + 1] += out.firstT[i];
+    out.pairT.resize(np);
+    std::vector<std::uint32_t> fill(out.firstT.begin(), out.firstT.end() - 1);
+    for (std::size_t k = 0; k < np; ++k) out.pairT[fill[out.partner[k]]++] = static_cast<std::uint32_t>(k);
+}
+
 /// Fills first/partner/shift from per-particle candidate lists, sorts each by j, carries history, and builds
 /// the transposed index.
 template <int D>
@@ -128,13 +140,7 @@ void finishList(std::size_t n, std::vector<std::vector<std::pair<std::uint32_t, 
             }
         }
     }
-    // Transposed index, in increasing pair order for each partner (deterministic gather order).
-    out.firstT.assign(n + 1, 0);
-    for (std::size_t k = 0; k < np; ++k) ++out.firstT[out.partner[k] + 1];
-    for (std::size_t i = 0; i < n; ++i) out.firstT[i + 1] += out.firstT[i];
-    out.pairT.resize(np);
-    std::vector<std::uint32_t> fill(out.firstT.begin(), out.firstT.end() - 1);
-    for (std::size_t k = 0; k < np; ++k) out.pairT[fill[out.partner[k]]++] = static_cast<std::uint32_t>(k);
+    buildTransposed(n, out);
 }
 
 }  // namespace
@@ -230,6 +236,110 @@ std::vector<std::uint32_t> spatialOrder(const Particles<D>& p, const Domain<D>& 
 }
 
 template <int D>
+void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s,
+                   const std::vector<std::uint32_t>& from, PairList<D>& list) {
+    constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+    constexpr std::uint8_t kMirror = (D == 2) ? 8 : 26;  // shift code of (j, i) = kMirror - code of (i, j)
+    const std::size_t n = from.size();
+    const std::size_t nOld = list.first.empty() ? 0 : list.first.size() - 1;
+    std::vector<std::uint32_t> inv(nOld, kNone);
+    std::vector<std::uint8_t> fresh(n, 0);
+    std::vector<std::uint32_t> freshList;
+    for (std::size_t k = 0; k < n; ++k) {
+        if (from[k] < nOld)
+            inv[from[k]] = static_cast<std::uint32_t>(k);
+        else {
+            fresh[k] = 1;
+            freshList.push_back(static_cast<std::uint32_t>(k));
+        }
+    }
+    struct Entry {
+        std::uint32_t a, b;
+        std::uint8_t code;
+        Vec<D> h;
+    };
+    std::vector<Entry> entries;
+    entries.reserve(list.partner.size() + 8 * freshList.size());
+    for (std::size_t i = 0; i < nOld; ++i) {
+        const std::uint32_t a = inv[i];
+        if (a == kNone) continue;
+        for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
+            const std::uint32_t b = inv[list.partner[k]];
+            if (b == kNone) continue;
+            const Vec<D> h = list.history.empty() ? Vec<D>::zero() : list.history[k];
+            if (a < b)
+                entries.push_back({a, b, list.shift[k], h});
+            else
+                entries.push_back({b, a, static_cast<std::uint8_t>(kMirror - list.shift[k]), -h});
+        }
+    }
+    if (!freshList.empty()) {
+        double rmax = 0;
+        for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
+        const Grid<D> g(dom, std::max(2 * rmax + s.skin, 1e-300));
+        std::vector<std::uint32_t> cellStart, members;
+        std::vector<int> cellOf;
+        sortIntoCells(p, g, cellStart, members, cellOf);
+        for (const std::uint32_t f : freshList) {
+            std::array<int, D> c;
+            for (int k = 0; k < D; ++k) c[k] = g.coord(p.x[f], k);
+            int cells[27];
+            int nc = 0;
+            constexpr int m = (D == 2) ? 9 : 27;
+            for (int code = 0; code < m; ++code) {
+                std::array<int, D> cc;
+                bool ok = true;
+                int t = code;
+                for (int k = 0; k < D; ++k) {
+                    int ck = c[k] + (t % 3) - 1;
+                    t /= 3;
+                    if (ck < 0 || ck >= g.n[k]) {
+                        if (!dom.periodic[k]) { ok = false; break; }
+                        ck = (ck + g.n[k]) % g.n[k];
+                    }
+                    cc[k] = ck;
+                }
+                if (ok) cells[nc++] = g.index(cc);
+            }
+            std::sort(cells, cells + nc);
+            nc = static_cast<int>(std::unique(cells, cells + nc) - cells);
+            for (int q = 0; q < nc; ++q)
+                for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) {
+                    const std::uint32_t j = members[a];
+                    if (j == f || (fresh[j] && j < f)) continue;  // a pair of two new particles once
+                    const std::uint32_t lo = std::min(f, j), hi = std::max(f, j);
+                    std::uint8_t code;
+                    if (testPair(p, dom, s, lo, hi, code)) entries.push_back({lo, hi, code, Vec<D>::zero()});
+                }
+        }
+    }
+    // Counting sort by the first index, then each (short) row by the partner.
+    list.first.assign(n + 1, 0);
+    for (const Entry& e : entries) ++list.first[e.a + 1];
+    for (std::size_t i = 0; i < n; ++i) list.first[i + 1] += list.first[i];
+    std::vector<std::uint32_t> fill(list.first.begin(), list.first.end() - 1);
+    const std::size_t np = entries.size();
+    list.partner.resize(np);
+    list.shift.resize(np);
+    list.history.resize(np);
+    for (const Entry& e : entries) {
+        const std::uint32_t o = fill[e.a]++;
+        list.partner[o] = e.b;
+        list.shift[o] = e.code;
+        list.history[o] = e.h;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::uint32_t k = list.first[i] + 1; k < list.first[i + 1]; ++k)
+            for (std::uint32_t q = k; q > list.first[i] && list.partner[q - 1] > list.partner[q]; --q) {
+                std::swap(list.partner[q - 1], list.partner[q]);
+                std::swap(list.shift[q - 1], list.shift[q]);
+                std::swap(list.history[q - 1], list.history[q]);
+            }
+    list.shiftVec = makeShiftVectors(dom);
+    buildTransposed(n, list);
+}
+
+template <int D>
 void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order) {
     const std::size_t n = order.size();
     const std::size_t nOld = list.first.empty() ? 0 : list.first.size() - 1;
@@ -271,7 +381,9 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     template void buildAllPairs<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, PairList<D>&); \
     template void wrapPositions<D>(Particles<D>&, const Domain<D>&);                                            \
     template std::vector<std::uint32_t> spatialOrder<D>(const Particles<D>&, const Domain<D>&, double);         \
-    template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);
+    template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);                        \
+    template void remapPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&,               \
+                                   const std::vector<std::uint32_t>&, PairList<D>&);
 HAET_INSTANTIATE(2)
 HAET_INSTANTIATE(3)
 #undef HAET_INSTANTIATE

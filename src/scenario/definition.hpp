@@ -109,7 +109,7 @@ struct HaetDef {
     std::optional<double> zoneSize;   ///< zone cell edge [m]; default 4 x the largest diameter
     std::optional<double> phiOn;      ///< a zone turns dense above this volume (area) fraction [-]
     std::optional<double> phiOff;     ///< and dilute again below this one [-]; phi_off < phi_on
-    int relabelEvery = 10;            ///< zone re-labelling period [TDM steps]
+    int relabelEvery = 50;            ///< zone re-labelling and mode-change period [TDM steps]
     int buffer = 1;                   ///< zones around a dense zone whose particles are TDM too [cells]
     int diluteSteps = 20;             ///< a TDM particle returns to EDM after its zone is dilute this long [steps]
     std::optional<double> dtMin;      ///< modified EDM: minimum time between collisions [s]; default t_c

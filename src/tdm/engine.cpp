@@ -125,9 +125,13 @@ void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
     wallHistory_.swap(wh);
     motion_.v.swap(mv);
     motion_.w.swap(mw);
-    permutePairList(pairs_, from);
     integ_->remap(p, from, s_.dt);
-    rebuild(false);
+    // The pair list follows incrementally (kept pairs, plus the new particles' pairs found now); the drift check
+    // then measures each particle from where it entered the list.
+    remapPairList(p, w_.domain, NeighborSettings{s_.skin, true}, from, pairs_);
+    std::vector<Vec<D>> xb(n);
+    for (std::size_t k = 0; k < n; ++k) xb[k] = from[k] == kFresh ? p.x[k] : xAtBuild_[from[k]];
+    xAtBuild_.swap(xb);
 }
 
 template <int D>

@@ -41,7 +41,8 @@ public:
     /// After the particles in [0, tdmCount()) changed (a hybrid moved some in or out): new particle k was old
     /// particle from[k], or is new to this engine (kFresh). Per-particle history follows; a new particle starts
     /// with no contact history and the integrator history of free flight under gravity (it comes from ballistic
-    /// flight); the pair list is rebuilt. Call at a step boundary.
+    /// flight); the pair list keeps the pairs of kept particles and gains those of new ones (remapPairList).
+    /// Call at a step boundary.
     static constexpr std::uint32_t kFresh = 0xFFFFFFFFu;
     void remap(const std::vector<std::uint32_t>& from);
     /// out[i]: contacts of particle i at the current positions, a wall contact counting 2 (resting on a wall
