@@ -266,8 +266,9 @@ int checkSeries(const fs::path& file) {
     return rows;
 }
 
-/// Checks a .pvd collection: every listed file exists and is a VTK XML file. Returns the number listed.
-int checkPvd(const fs::path& pvdFile) {
+/// Checks a .pvd collection: every listed file exists and is a VTK XML file of the given extension. Returns the
+/// number listed.
+int checkPvd(const fs::path& pvdFile, const std::string& extension = ".vtu") {
     std::ifstream in(pvdFile);
     std::stringstream ss;
     ss << in.rdbuf();
@@ -278,7 +279,7 @@ int checkPvd(const fs::path& pvdFile) {
     int listed = 0;
     for (auto it = std::sregex_iterator(pvd.begin(), pvd.end(), fileRe); it != std::sregex_iterator(); ++it) {
         const fs::path vtu = pvdFile.parent_path() / (*it)[1].str();
-        EXPECT_EQ(vtu.extension(), ".vtu");
+        EXPECT_EQ(vtu.extension(), extension);
         std::ifstream v(vtu);
         std::string head(200, '\0');
         v.read(head.data(), head.size());
@@ -359,6 +360,33 @@ TEST_F(Cli, RunWritesOutputs) {
     int vtuFiles = 0;
     for (const auto& e : fs::directory_iterator(out)) vtuFiles += e.path().extension() == ".vtu";
     EXPECT_EQ(vtuFiles, 3);
+}
+
+// method = "haet": the hybrid's columns in series.csv, the mode field in the snapshots, the zone images, and
+// `haet check` naming the values in force.
+TEST_F(Cli, HybridRunWritesModesZonesAndColumns) {
+    const std::string text = edit("duration = 0.001", "duration = 0.002\nmethod = \"haet\"") +
+                             "\n[haet]\nrelabel_every = 20\n";
+    const fs::path f = write("hybrid.toml", text);
+    const Result c = haet("check '" + f.string() + "'");
+    ASSERT_EQ(c.code, 0) << c.err;
+    for (const char* key : {"haet", "phi_on", "relabel every 20 steps", "dt_min"})
+        EXPECT_NE(c.out.find(key), std::string::npos) << key << " in: " << c.out;
+    const fs::path out = dir_ / "run";
+    const Result r = haet("run -q '" + f.string() + "' --out '" + out.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(checkSeries(out / "series.csv"), 21);
+    const std::string series = read(out / "series.csv");
+    const std::string header = series.substr(0, series.find('\n'));
+    for (const char* col : {"n_tdm", "n_edm", "events", "tdm_steps", "dissipated_tdm", "dissipated_edm",
+                            "energy_unaccounted"})
+        EXPECT_NE(header.find(col), std::string::npos) << col << " in: " << header;
+    EXPECT_EQ(checkPvd(out / "zones.pvd", ".vti"), 5);
+    EXPECT_TRUE(fs::exists(out / "zones_000000.vti"));
+    EXPECT_NE(read(out / "particles_000001.vtu").find("Name=\"mode\""), std::string::npos);
+    const std::string json = read(out / "run.json");
+    EXPECT_EQ(jsonString(json, "method"), "haet");
+    EXPECT_EQ(jsonString(json, "status"), "completed");
 }
 
 // dt = t_c for 8 hot spheres (about 1 m/s) in a closed box: with omega dt = pi the linear spring is unstable
