@@ -65,17 +65,7 @@ void EdmEngine<D>::reset() {
             throw std::invalid_argument("event-driven engine: periodic axis " + std::to_string(k) +
                                         " is shorter than two particle diameters");
     // Periodic positions into the box (frozen particles too: they never move afterwards).
-    for (std::size_t i = first; i < n; ++i) {
-        for (int k = 0; k < D; ++k) {
-            if (!w_.domain.periodic[k]) continue;
-            double& x = p.x[i][k];
-            const double lo = w_.domain.lo[k], L = boxLen_[k];
-            if (x >= lo && x < lo + L) continue;
-            const double s = std::floor((x - lo) / L);
-            x -= s * L;
-            p.image[i][k] += s * L;
-        }
-    }
+    for (std::size_t i = first; i < n; ++i) wrapIntoBox(i);
     // Event-rate bound (docs/edm.md): as given; else 1000 per TC time; else 10^4 per d_min/u, u the larger of
     // the rms speed, sqrt(|g| d_min) and the fastest wall speed. Physical event rates stay far below.
     if (s_.maxEventRate > 0) {
@@ -122,6 +112,20 @@ void EdmEngine<D>::reset() {
     if (s_.reference) return;
     for (std::uint32_t s = 0; s < n; ++s)
         if (!frozen(s)) predict(s, w_.time);
+}
+
+template <int D>
+void EdmEngine<D>::wrapIntoBox(std::size_t i) {
+    Particles<D>& p = w_.particles;
+    for (int k = 0; k < D; ++k) {
+        if (!w_.domain.periodic[k]) continue;
+        double& x = p.x[i][k];
+        const double lo = w_.domain.lo[k], L = boxLen_[k];
+        if (x >= lo && x < lo + L) continue;
+        const double sh = std::floor((x - lo) / L);
+        x -= sh * L;
+        p.image[i][k] += sh * L;
+    }
 }
 
 template <int D>
@@ -919,15 +923,7 @@ void EdmEngine<D>::add(std::size_t i, double t) {
     if (p.radius[i] > rmax_ * (1 + 1e-12)) throw std::logic_error("event-driven engine: particle larger than the grid");
     const std::uint32_t s = free_.back();
     free_.pop_back();
-    for (int k = 0; k < D; ++k) {
-        if (!w_.domain.periodic[k]) continue;
-        double& x = p.x[i][k];
-        const double lo = w_.domain.lo[k], L = boxLen_[k];
-        if (x >= lo && x < lo + L) continue;
-        const double sh = std::floor((x - lo) / L);
-        x -= sh * L;
-        p.image[i][k] += sh * L;
-    }
+    wrapIntoBox(i);
     const bool fz = p.frozen(i);
     hot_[s] = Hot{p.x[i], fz ? kNever : t, fz ? Vec<D>::zero() : p.v[i], p.radius[i]};
     link_[s].wrap = Shift{};
@@ -946,24 +942,10 @@ void EdmEngine<D>::add(std::size_t i, double t) {
     }
     // A new obstacle: the moving particles around it re-predict (their events did not know it).
     std::vector<std::uint32_t> around;
-    const std::uint32_t c = rec_[s].cell;
-    for (int code = 0; code < (D == 3 ? 27 : 9); ++code) {
-        std::uint32_t cell = 0;
-        bool ok = true;
-        int q = code;
-        for (int k = 0; k < D; ++k) {
-            int ck = static_cast<int>((c / stride_[k]) % static_cast<std::uint32_t>(nCell_[k])) + q % 3 - 1;
-            q /= 3;
-            if (ck < 0 || ck >= nCell_[k]) {
-                if (!w_.domain.periodic[k]) { ok = false; break; }
-                ck = (ck + nCell_[k]) % nCell_[k];
-            }
-            cell += static_cast<std::uint32_t>(ck) * stride_[k];
-        }
-        if (!ok) continue;
+    forEachNeighbourCell(rec_[s].cell, [&](std::uint32_t cell) {
         for (std::uint32_t j = head_[cell]; j != kNil; j = link_[j].next)
             if (!frozen(j)) around.push_back(j);
-    }
+    });
     std::sort(around.begin(), around.end());
     around.erase(std::unique(around.begin(), around.end()), around.end());
     for (const std::uint32_t j : around) predict(j, t);

@@ -130,6 +130,32 @@ public:
     std::uint32_t cellCount() const { return static_cast<std::uint32_t>(head_.size()); }
     const std::array<int, D>& cellDims() const { return nCell_; }
     const Vec<D>& cellWidths() const { return cellW_; }
+    /// Calls f(cell index) for cell c and its 3^D - 1 neighbours (periodic axes wrap, open ones end; on a periodic
+    /// axis of fewer than 3 cells a cell can come twice).
+    template <class F>
+    void forEachNeighbourCell(std::uint32_t c, F&& f) const {
+        std::array<int, D> cc;
+        for (int k = 0; k < D; ++k) cc[k] = static_cast<int>((c / stride_[k]) % static_cast<std::uint32_t>(nCell_[k]));
+        constexpr int m = D == 3 ? 27 : 9;
+        for (int code = 0; code < m; ++code) {
+            std::uint32_t idx = 0;
+            bool ok = true;
+            int q = code;
+            for (int k = 0; k < D; ++k) {
+                int ck = cc[k] + q % 3 - 1;
+                q /= 3;
+                if (ck < 0 || ck >= nCell_[k]) {
+                    if (!w_.domain.periodic[k]) {
+                        ok = false;
+                        break;
+                    }
+                    ck = (ck + nCell_[k]) % nCell_[k];
+                }
+                idx += static_cast<std::uint32_t>(ck) * stride_[k];
+            }
+            if (ok) f(idx);
+        }
+    }
     /// Calls f(World index) for every particle of this engine in cell c.
     template <class F>
     void forEachInCell(std::uint32_t c, F&& f) const {
@@ -187,6 +213,8 @@ private:
     };
 
     void buildGrid();
+    /// World particle i into the box on periodic axes (wraps recorded in Particles::image).
+    void wrapIntoBox(std::size_t i);
     std::uint32_t cellOf(const Vec<D>& x) const;
     void linkCells();
     void insertCell(std::uint32_t s, std::uint32_t c);

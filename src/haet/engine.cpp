@@ -138,17 +138,6 @@ void HaetEngine<D>::synchronise() {
 // the guard
 
 template <int D>
-std::array<int, D> HaetEngine<D>::cellCoords(std::uint32_t c) const {
-    std::array<int, D> a;
-    const std::array<int, D>& nc = edm_->cellDims();
-    for (int k = 0; k < D; ++k) {
-        a[k] = static_cast<int>(c % static_cast<std::uint32_t>(nc[k]));
-        c /= static_cast<std::uint32_t>(nc[k]);
-    }
-    return a;
-}
-
-template <int D>
 void HaetEngine<D>::bin(const Vec<D>& x, double r) {
     const std::uint32_t c = edm_->cellIndex(x);
     if (binHead_[c] == kNil) binCells_.push_back(c);
@@ -156,65 +145,24 @@ void HaetEngine<D>::bin(const Vec<D>& x, double r) {
     binHead_[c] = static_cast<std::uint32_t>(bins_.size() - 1);
 }
 
-// The 3^D cells around `cell` get at least `level` (in the new-level bits 2-3 during a relabel).
 template <int D>
-void HaetEngine<D>::markAround(std::uint32_t cell, std::uint8_t level, std::vector<std::uint32_t>& arrivals) {
-    const std::array<int, D> cc = cellCoords(cell);
-    const std::array<int, D>& nc = edm_->cellDims();
-    constexpr int m = D == 3 ? 27 : 9;
-    for (int code = 0; code < m; ++code) {
-        std::uint32_t idx = 0, stride = 1;
-        bool ok = true;
-        int q = code;
-        for (int k = 0; k < D; ++k) {
-            int ck = cc[k] + q % 3 - 1;
-            q /= 3;
-            if (ck < 0 || ck >= nc[k]) {
-                if (!w_.domain.periodic[k]) {
-                    ok = false;
-                    break;
-                }
-                ck = (ck + nc[k]) % nc[k];
-            }
-            idx += static_cast<std::uint32_t>(ck) * stride;
-            stride *= static_cast<std::uint32_t>(nc[k]);
-        }
-        if (!ok) continue;
+void HaetEngine<D>::markAround(std::uint32_t cell, std::uint8_t level) {
+    edm_->forEachNeighbourCell(cell, [&](std::uint32_t idx) {
         std::uint8_t& g = guard_[idx];
         const std::uint8_t oldLevel = g & 3, newLevel = g >> 2;
-        if (newLevel >= level) continue;
+        if (newLevel >= level) return;
         if (newLevel == 0) newList_.push_back(idx);
         g = static_cast<std::uint8_t>(oldLevel | (level << 2));
         if (level > oldLevel)  // occupants of a cell that became stricter are watched
             edm_->forEachInCell(idx, [&](std::uint32_t i) { watch_.push_back(i); });
-    }
+    });
 }
 
 template <int D>
 double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r) const {
     double gap = kNever;
-    const std::array<int, D> cc = cellCoords(edm_->cellIndex(x));
-    const std::array<int, D>& nc = edm_->cellDims();
     const Vec<D> L = w_.domain.length();
-    constexpr int m = D == 3 ? 27 : 9;
-    for (int code = 0; code < m; ++code) {
-        std::uint32_t idx = 0, stride = 1;
-        bool ok = true;
-        int q = code;
-        for (int k = 0; k < D; ++k) {
-            int ck = cc[k] + q % 3 - 1;
-            q /= 3;
-            if (ck < 0 || ck >= nc[k]) {
-                if (!w_.domain.periodic[k]) {
-                    ok = false;
-                    break;
-                }
-                ck = (ck + nc[k]) % nc[k];
-            }
-            idx += static_cast<std::uint32_t>(ck) * stride;
-            stride *= static_cast<std::uint32_t>(nc[k]);
-        }
-        if (!ok) continue;
+    edm_->forEachNeighbourCell(edm_->cellIndex(x), [&](std::uint32_t idx) {
         for (std::uint32_t b = binHead_[idx]; b != kNil; b = bins_[b].next) {
             Vec<D> d = x - bins_[b].x;
             for (int k = 0; k < D; ++k)
@@ -222,7 +170,7 @@ double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r) const {
             const double reach = r + bins_[b].r + margin_, d2 = norm2(d);
             if (d2 < reach * reach && d2 > 0) gap = std::min(gap, std::sqrt(d2) - r - bins_[b].r);
         }
-    }
+    });
     return gap;
 }
 
@@ -352,7 +300,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
             if (k == D) break;
         }
     }
-    for (std::size_t b = 0, nb = binCells_.size(); b < nb; ++b) markAround(binCells_[b], 1, arrivals);
+    for (std::size_t b = 0, nb = binCells_.size(); b < nb; ++b) markAround(binCells_[b], 1);
     // A candidate within reach of a staying TDM particle, or whose event-grid cell belongs to a time-driven zone,
     // stays (it would be handed back at once); so may its neighbours then.
     std::vector<std::uint32_t> departures;
@@ -364,7 +312,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
             if ((guard_[c] >> 2) >= 2 || gapToTdm(p.x[i], p.radius[i]) < margin_) {
                 const bool fresh = binHead_[c] == kNil;
                 bin(p.x[i], p.radius[i]);
-                if (fresh) markAround(c, 1, arrivals);
+                if (fresh) markAround(c, 1);
                 changed = true;
                 continue;
             }
@@ -446,36 +394,15 @@ void HaetEngine<D>::convert(std::vector<std::uint32_t> arrivals, std::vector<std
     }
     tdm_->remap(from);
     // The new TDM particles guard their surroundings until the next relabel.
-    std::vector<std::uint32_t> more;
     for (std::size_t k = 0; k < nT; ++k) {
         if (from[k] != TdmEngine<D>::kFresh) continue;
-        const std::uint32_t c = edm_->cellIndex(p.x[k]);
         bin(p.x[k], p.radius[k]);
-        const std::array<int, D> cc = cellCoords(c);
-        const std::array<int, D>& nc = edm_->cellDims();
-        constexpr int m = D == 3 ? 27 : 9;
-        for (int code = 0; code < m; ++code) {
-            std::uint32_t idx = 0, stride = 1;
-            bool ok = true;
-            int q = code;
-            for (int a = 0; a < D; ++a) {
-                int ck = cc[a] + q % 3 - 1;
-                q /= 3;
-                if (ck < 0 || ck >= nc[a]) {
-                    if (!w_.domain.periodic[a]) {
-                        ok = false;
-                        break;
-                    }
-                    ck = (ck + nc[a]) % nc[a];
-                }
-                idx += static_cast<std::uint32_t>(ck) * stride;
-                stride *= static_cast<std::uint32_t>(nc[a]);
-            }
-            if (!ok || guard_[idx] != 0) continue;
+        edm_->forEachNeighbourCell(edm_->cellIndex(p.x[k]), [&](std::uint32_t idx) {
+            if (guard_[idx] != 0) return;
             guard_[idx] = 1;
             guardList_.push_back(idx);
             edm_->forEachInCell(idx, [&](std::uint32_t i) { watch_.push_back(i); });
-        }
+        });
     }
 }
 

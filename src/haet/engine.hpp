@@ -95,13 +95,14 @@ private:
     void checkWatched(std::vector<std::uint32_t>& arrivals, bool due);
     void convert(std::vector<std::uint32_t> arrivals, std::vector<std::uint32_t> departures);
     void bin(const Vec<D>& x, double r);
-    void markAround(std::uint32_t cell, std::uint8_t level, std::vector<std::uint32_t>& arrivals);
+    /// The 3^D cells around `cell` get at least guard `level` (new-level bits during a relabel); occupants of a
+    /// cell that became stricter are watched.
+    void markAround(std::uint32_t cell, std::uint8_t level);
     /// Smallest gap between a sphere (x, r) and the binned TDM particles within the margin (one at x itself
     /// excluded); infinity if none.
     double gapToTdm(const Vec<D>& x, double r) const;
     double particleEnergy(std::size_t i) const;
     double tdmEnergy() const;
-    std::array<int, D> cellCoords(std::uint32_t c) const;
 
     World<D>& w_;
     TdmSettings ts_;

@@ -41,6 +41,33 @@ struct Grid {
     }
 };
 
+/// The cell of x and its neighbours, de-duplicated (a periodic axis with fewer than 3 cells maps offsets
+/// together), in increasing order. Returns their number (at most 3^D).
+template <int D>
+int neighbourCells(const Grid<D>& g, const Domain<D>& dom, const Vec<D>& x, int* cells) {
+    std::array<int, D> c;
+    for (int k = 0; k < D; ++k) c[k] = g.coord(x, k);
+    int nc = 0;
+    constexpr int m = (D == 2) ? 9 : 27;
+    for (int code = 0; code < m; ++code) {
+        std::array<int, D> cc;
+        bool ok = true;
+        int t = code;
+        for (int k = 0; k < D; ++k) {
+            int ck = c[k] + (t % 3) - 1;
+            t /= 3;
+            if (ck < 0 || ck >= g.n[k]) {
+                if (!dom.periodic[k]) { ok = false; break; }
+                ck = (ck + g.n[k]) % g.n[k];
+            }
+            cc[k] = ck;
+        }
+        if (ok) cells[nc++] = g.index(cc);
+    }
+    std::sort(cells, cells + nc);
+    return static_cast<int>(std::unique(cells, cells + nc) - cells);
+}
+
 /// Particles sorted by cell: cellStart (size total+1) and the particle indices in cell order.
 template <int D>
 void sortIntoCells(const Particles<D>& p, const Grid<D>& g, std::vector<std::uint32_t>& cellStart,
@@ -177,29 +204,8 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
     std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> cand(n);
 #pragma omp parallel for schedule(dynamic, 256) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
-        std::array<int, D> c;
-        for (int k = 0; k < D; ++k) c[k] = g.coord(p.x[i], k);
-        // Neighbouring cells, de-duplicated (a periodic axis with fewer than 3 cells maps offsets together).
         int cells[27];
-        int nc = 0;
-        constexpr int m = (D == 2) ? 9 : 27;
-        for (int code = 0; code < m; ++code) {
-            std::array<int, D> cc;
-            bool ok = true;
-            int t = code;
-            for (int k = 0; k < D; ++k) {
-                int ck = c[k] + (t % 3) - 1;
-                t /= 3;
-                if (ck < 0 || ck >= g.n[k]) {
-                    if (!dom.periodic[k]) { ok = false; break; }
-                    ck = (ck + g.n[k]) % g.n[k];
-                }
-                cc[k] = ck;
-            }
-            if (ok) cells[nc++] = g.index(cc);
-        }
-        std::sort(cells, cells + nc);
-        nc = static_cast<int>(std::unique(cells, cells + nc) - cells);
+        const int nc = neighbourCells(g, dom, p.x[i], cells);
         auto& ci = cand[i];
         for (int q = 0; q < nc; ++q) {
             for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) {
@@ -281,28 +287,8 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
         std::vector<int> cellOf;
         sortIntoCells(p, g, cellStart, members, cellOf);
         for (const std::uint32_t f : freshList) {
-            std::array<int, D> c;
-            for (int k = 0; k < D; ++k) c[k] = g.coord(p.x[f], k);
             int cells[27];
-            int nc = 0;
-            constexpr int m = (D == 2) ? 9 : 27;
-            for (int code = 0; code < m; ++code) {
-                std::array<int, D> cc;
-                bool ok = true;
-                int t = code;
-                for (int k = 0; k < D; ++k) {
-                    int ck = c[k] + (t % 3) - 1;
-                    t /= 3;
-                    if (ck < 0 || ck >= g.n[k]) {
-                        if (!dom.periodic[k]) { ok = false; break; }
-                        ck = (ck + g.n[k]) % g.n[k];
-                    }
-                    cc[k] = ck;
-                }
-                if (ok) cells[nc++] = g.index(cc);
-            }
-            std::sort(cells, cells + nc);
-            nc = static_cast<int>(std::unique(cells, cells + nc) - cells);
+            const int nc = neighbourCells(g, dom, p.x[f], cells);
             for (int q = 0; q < nc; ++q)
                 for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) {
                     const std::uint32_t j = members[a];
