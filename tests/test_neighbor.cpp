@@ -98,13 +98,13 @@ TEST(Neighbor, HistorySurvivesRebuildAndPermutation) {
 /// takes a leaver's place) and new ones join at the end; the pairs must be those of a fresh build, and the history
 /// of kept pairs must follow its particles.
 template <int D>
-void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed) {
+void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed, std::size_t joining) {
     Domain<D> dom;
     dom.lo = Vec<D>::zero();
     dom.hi = Vec<D>::filled(1.0);
     dom.periodic = periodic;
     auto all = randomParticles<D>(D == 2 ? 1200 : 1500, dom, 0.01, 0.04, seed);
-    const std::size_t n0 = all.size() - 100;  // the last 100 are outside the list at first
+    const std::size_t n0 = all.size() - 100;  // the last 100 are outside the list at first; `joining` of them join
     all.nTdm = n0;
     NeighborSettings s{0.02, true};
     PairList<D> list;
@@ -112,7 +112,7 @@ void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed) {
     for (std::size_t i = 0; i < n0; ++i)
         for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k)
             list.history[k] = Vec<D>::filled(double(all.id[i]) * 10000 + double(all.id[list.partner[k]]));
-    // 60 leave (every 17th), 100 join.
+    // 60 leave (every 17th), `joining` join (a few: tested against all; many: with a grid).
     std::vector<std::uint32_t> from(n0);
     for (std::size_t k = 0; k < n0; ++k) from[k] = static_cast<std::uint32_t>(k);
     std::size_t nT = n0;
@@ -123,8 +123,8 @@ void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed) {
         --nT;
         if (d == 0) break;
     }
-    // the leavers now sit at [nT, n0); bring the 100 outsiders in front of them
-    for (std::size_t k = 0; k < 100; ++k) {
+    // the leavers now sit at [nT, n0); bring `joining` outsiders in front of them
+    for (std::size_t k = 0; k < joining; ++k) {
         all.swapEntries(n0 + k, nT);
         from.push_back(0xFFFFFFFFu);
         ++nT;
@@ -149,13 +149,15 @@ void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed) {
 }
 
 TEST(Neighbor, RemapAfterModeChangeMatchesBuild3D) {
-    remapMatchesBuild<3>({true, true, true}, 21);
-    remapMatchesBuild<3>({false, true, false}, 22);
+    remapMatchesBuild<3>({true, true, true}, 21, 100);
+    remapMatchesBuild<3>({false, true, false}, 22, 100);
+    remapMatchesBuild<3>({true, true, true}, 25, 5);
 }
 
 TEST(Neighbor, RemapAfterModeChangeMatchesBuild2D) {
-    remapMatchesBuild<2>({true, true}, 23);
-    remapMatchesBuild<2>({false, false}, 24);
+    remapMatchesBuild<2>({true, true}, 23, 100);
+    remapMatchesBuild<2>({false, false}, 24, 100);
+    remapMatchesBuild<2>({false, true}, 26, 3);
 }
 
 }  // namespace

@@ -15,12 +15,26 @@ struct Grid {
     Vec<D> lo, width;
     int total = 1;
 
-    Grid(const Domain<D>& dom, double cellSize) {
+    /// A grid over the box on periodic axes and over the particles [0, tdmCount()) on open ones: a hybrid run's
+    /// time-driven particles may fill a small part of a tall box.
+    Grid(const Domain<D>& dom, double cellSize, const Particles<D>& p) {
+        Vec<D> hi = dom.hi;
         lo = dom.lo;
+        const std::size_t np = p.tdmCount();
         for (int k = 0; k < D; ++k) {
-            const double L = dom.hi[k] - dom.lo[k];
+            if (dom.periodic[k] || np == 0) continue;
+            double a = p.x[0][k], b = a;
+            for (std::size_t i = 1; i < np; ++i) {
+                a = std::min(a, p.x[i][k]);
+                b = std::max(b, p.x[i][k]);
+            }
+            // Within the box: particles beyond it (an open axis) fall into the outer cells, as before.
+            lo[k] = std::clamp(a, dom.lo[k], dom.hi[k]);
+            hi[k] = std::max(std::clamp(b, dom.lo[k], dom.hi[k]), lo[k] + cellSize);
+        }
+        for (int k = 0; k < D; ++k) {
+            const double L = hi[k] - lo[k];
             n[k] = std::max(1, static_cast<int>(std::floor(L / cellSize)));
-            // Keep the grid small for huge boxes with few particles: at most ~2^22 cells in all.
             width[k] = L / n[k];
             total *= n[k];
         }
@@ -193,9 +207,15 @@ template <int D>
 void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, const PairList<D>& old,
                    PairList<D>& out) {
     const std::size_t n = p.tdmCount();
+    if (n == 0) {  // no particles (a hybrid run whose particles are all event-driven): no grid either
+        std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> none;
+        out.shiftVec = makeShiftVectors(dom);
+        finishList(0, none, old, out);
+        return;
+    }
     double rmax = 0;
     for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
-    const Grid<D> g(dom, std::max(2 * rmax + s.skin, 1e-300));
+    const Grid<D> g(dom, std::max(2 * rmax + s.skin, 1e-300), p);
     std::vector<std::uint32_t> cellStart, members;
     std::vector<int> cellOf;
     sortIntoCells(p, g, cellStart, members, cellOf);
@@ -234,7 +254,8 @@ void buildAllPairs(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
 
 template <int D>
 std::vector<std::uint32_t> spatialOrder(const Particles<D>& p, const Domain<D>& dom, double cellSize) {
-    const Grid<D> g(dom, cellSize);
+    if (p.tdmCount() == 0) return {};
+    const Grid<D> g(dom, cellSize, p);
     std::vector<std::uint32_t> cellStart, members;
     std::vector<int> cellOf;
     sortIntoCells(p, g, cellStart, members, cellOf);
@@ -279,10 +300,19 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 entries.push_back({b, a, static_cast<std::uint8_t>(kMirror - list.shift[k]), -h});
         }
     }
-    if (!freshList.empty()) {
+    // A few new particles are tested against all (a grid costs O(cells), and a tall box has many); many use a grid.
+    if (!freshList.empty() && freshList.size() * 64 <= n) {
+        for (const std::uint32_t f : freshList)
+            for (std::uint32_t j = 0; j < n; ++j) {
+                if (j == f || (fresh[j] && j < f)) continue;
+                const std::uint32_t lo = std::min(f, j), hi = std::max(f, j);
+                std::uint8_t code;
+                if (testPair(p, dom, s, lo, hi, code)) entries.push_back({lo, hi, code, Vec<D>::zero()});
+            }
+    } else if (!freshList.empty()) {
         double rmax = 0;
         for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
-        const Grid<D> g(dom, std::max(2 * rmax + s.skin, 1e-300));
+        const Grid<D> g(dom, std::max(2 * rmax + s.skin, 1e-300), p);
         std::vector<std::uint32_t> cellStart, members;
         std::vector<int> cellOf;
         sortIntoCells(p, g, cellStart, members, cellOf);
