@@ -79,6 +79,8 @@ struct ContactDef {
     double gammaT = 0;             ///< tangential damping, LAMMPS convention [1/s]
     bool attraction = false;       ///< false: normal force clipped at zero (no attraction while separating)
     double impactVelocity = 1.0;   ///< Hertz: impact speed used for t_c and the time-step rule [m/s]
+    /// Polygon contacts: dimensionless normal damping gamma of PHYSICS.md G.3; default from the restitution
+    std::optional<double> polygonDamping;
     SourcePos pos;
 };
 

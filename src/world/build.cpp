@@ -19,6 +19,10 @@ std::vector<MaterialStats> materialStats(const Particles<D>& p, int nMaterials) 
         s.minRadius = s.count ? std::min(s.minRadius, p.radius[i]) : p.radius[i];
         s.minMass = s.count ? std::min(s.minMass, p.mass[i]) : p.mass[i];
         ++s.count;
+        if (p.isPolygon(i)) {
+            s.minPolygonMass = s.polygons ? std::min(s.minPolygonMass, p.mass[i]) : p.mass[i];
+            ++s.polygons;
+        }
     }
     for (auto& s : st)
         if (s.count) {
