@@ -114,8 +114,8 @@ struct Particles {
             r2 = std::max(r2, norm2(p));
         }
         const double area = 0.5 * a2;
-        if (shape.empty()) shape.assign(x.size(), kNoShape);
         const std::size_t i = add(pos, vel, spin, std::sqrt(r2), density, mat, pid, flag);
+        shape.resize(x.size(), kNoShape);  // the first polygon turns the disks before it into kNoShape entries
         const double m = density * area;
         const double ipm = (io / 12.0) / area;  // about the centroid, which is now the origin
         mass[i] = m;

@@ -117,7 +117,7 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
     virial += dot(d, cf.f);
     // Depth of the overlap, area / chord, relative to the smaller bounding radius (1 when the chord vanishes).
     const double clen = norm(o.chord);
-    overlapRatio = std::max(overlapRatio, clen > 1e-3 * rmin ? o.area / clen / rmin : 1.0);
+    overlapRatio = std::max(overlapRatio, clen > 0 ? o.area / clen / rmin : 1.0);
     return true;
 }
 
@@ -267,7 +267,7 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
                     tq += cf.torqueI;
                     ps.wallEnergy[i] += polygonContactEnergy(c, o, cf.length);
                     const double clen = norm(o.chord);
-                    s.maxOverlap[i] = std::max(s.maxOverlap[i], clen > 1e-3 * ri ? o.area / clen / ri : 1.0);
+                    s.maxOverlap[i] = std::max(s.maxOverlap[i], clen > 0 ? o.area / clen / ri : 1.0);
                     ++wallContacts;
                     continue;
                 }
