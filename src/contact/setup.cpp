@@ -224,6 +224,7 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
             }
         }
     s.contactTime = tc;
+    s.diskContactTime = tc;
     if (cd.normal == NormalLaw::Linear)
         s.contactTimeNote = cd.kn ? "linear law, fixed k_n: t_c = pi/omega of the lightest pair"
                                   : "linear law: t_c as given";
@@ -248,7 +249,8 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
             yMax = std::max(yMax, pc.young);
             gMax = std::max(gMax, pc.gamma);
         }
-        s.polygonStep = kPi / 10 * std::sqrt(mPoly / yMax) * std::min(1.0, 0.2 / gMax);
+        s.polygonStepFactor = std::min(1.0, 0.2 / gMax);
+        s.polygonStep = kPi / 10 * std::sqrt(mPoly / yMax) * s.polygonStepFactor;
         const double tcPoly = kPi * std::sqrt(mPoly / yMax);
         if (polygons == all.count || !(tcPoly >= s.contactTime)) {
             s.contactTime = polygons == all.count ? tcPoly : std::min(s.contactTime, tcPoly);

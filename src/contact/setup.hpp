@@ -37,6 +37,10 @@ struct ContactSetup {
     /// Polygon time-step rule (PHYSICS.md F.3): (pi/10) sqrt(m_min / Y_max) over polygon particles [s]; 0 when the
     /// scene has no polygon.
     double polygonStep = 0;
+    double polygonStepFactor = 1;  ///< the factor min(1, 0.2/gamma) in polygonStep (strong damping) [-]
+    /// Contact duration of the disk law alone [s] (infinite when it has no coefficients): with polygons present,
+    /// contactTime is the shorter of this and the polygons' pi sqrt(m_min/Y).
+    double diskContactTime = 0;
 
     const PairCoeffs& pair(int a, int b) const { return table[a * nMaterials + b]; }
     const polygon::PolygonCoeffs& polygonPair(int a, int b) const { return polygonTable[a * nMaterials + b]; }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <fmt/format.h>
 #include <omp.h>
 #include <ostream>
@@ -18,6 +19,7 @@
 #include "io/series.hpp"
 #include "io/vtk.hpp"
 #include "edm/engine.hpp"
+#include "polygon/output.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
 
@@ -185,6 +187,14 @@ public:
                         {"id", 1, VtkField::Int64, ids.data()}},
                        time);
         pvd_.add(time, name);
+        if constexpr (D == 2) {
+            if (p.hasPolygons()) {  // the real shapes, as polygon cells (polygons.pvd)
+                if (!polys_) polys_.emplace(dir_ / "polygons.pvd");
+                const std::string pname = fmt::format("polygons_{:06d}.vtu", count_);
+                polygon::writePolygonVtu(dir_ / pname, p, time);
+                polys_->add(time, pname);
+            }
+        }
         if (!w.walls.empty()) {
             const std::string wname = fmt::format("walls_{:06d}.vtp", count_);
             writeVtpWalls(dir_ / wname, wallQuads(w, time));
@@ -236,6 +246,7 @@ private:
 
     std::filesystem::path dir_;
     PvdCollection pvd_, walls_;
+    std::optional<PvdCollection> polys_;
     int count_ = 0;
 };
 
@@ -251,7 +262,11 @@ void writePicture(const World<2>& w, const std::filesystem::path& path) {
     for (std::size_t i = 0; i < p.size(); ++i) {
         const double s = vmax > 0 ? norm(p.v[i]) / vmax : 0;
         const auto r = static_cast<std::uint32_t>(60 + 195 * s), b = static_cast<std::uint32_t>(255 - 195 * s);
-        scene.disks.push_back({p.x[i][0], p.x[i][1], p.radius[i], p.frozen(i) ? 0x606060u : (r << 16) | (90u << 8) | b});
+        const std::uint32_t rgb = p.frozen(i) ? 0x606060u : (r << 16) | (90u << 8) | b;
+        if (p.isPolygon(i))
+            scene.polygons.push_back({polygon::worldOutline(p, i), rgb});
+        else
+            scene.disks.push_back({p.x[i][0], p.x[i][1], p.radius[i], rgb});
     }
     for (const Wall<2>& wl : w.walls) {
         const Vec<2> pt = wl.pointAt(w.time);
@@ -413,6 +428,9 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
                        std::count_if(world.particles.flags.begin(), world.particles.flags.end(),
                                      [](std::uint8_t f) { return f & kFrozen; }),
                        sc.materials.size(), world.walls.size());
+    if (world.particles.hasPolygons())
+        out << fmt::format("polygons   {} (overlap-area law, PHYSICS.md G.3; the rest are disks)\n",
+                           world.particles.shapes.size());
     out << fmt::format("contact    {} normal law, {} tangential; contact duration t_c = {:.4g} s ({})\n",
                        sc.contact.normal == NormalLaw::Linear ? "linear" : "hertz",
                        sc.contact.tangential == TangentialLaw::Spring ? "spring" : "no",
