@@ -29,6 +29,7 @@ struct PolygonScratch {
     std::vector<double> torqueJ;    ///< threaded path: torque on j of each pair [N m]
     std::vector<double> pairEnergy; ///< estimated elastic energy of each pair [J] (contactEnergy)
     std::vector<double> wallEnergy; ///< per particle: estimated elastic energy of its wall contacts [J]
+    std::vector<double> torque;     ///< per particle: pair torques [N m]
 };
 
 /// Turns every polygon's body-frame vertices by its current angle.
@@ -144,7 +145,8 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
     s.virial.assign(n, 0.0);
     ps.wallEnergy.assign(n, 0.0);
     ps.pairEnergy.assign(np, 0.0);
-    std::vector<double> torque(n, 0.0);
+    std::vector<double>& torque = ps.torque;
+    torque.assign(n, 0.0);
     const bool clip = !cs.attraction;
     const int nm = cs.nMaterials;
     const PairCoeffs* table = cs.table.data();
