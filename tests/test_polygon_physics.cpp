@@ -97,6 +97,53 @@ TEST(PolygonStatic, OverlapCarriesTheWeight) {
     }
 }
 
+// Mixed contacts: a disk resting on a frozen polygon (a wide flat block) and a hexagon resting on a frozen disk carry
+// their weight with the polygon law, Y A / l = m g, measured from the final state with the circle-polygon overlap.
+TEST(PolygonStatic, DiskOnPolygonAndPolygonOnDisk) {
+    for (int polygonOnTop = 0; polygonOnTop < 2; ++polygonOnTop) {
+        Scenario sc = testing::linearScenario(2, 0.3, 1e-3, 0.5, TangentialLaw::Spring);
+        sc.materials[0].young = kYoung;
+        World<2> w;
+        w.domain = testing::openBox<2>(0.2);
+        w.domain.gravity = V2{{0, -9.81}};
+        const double Rb = 0.02;  // the base: frozen, centred at the origin
+        if (polygonOnTop) {
+            w.particles.add(V2::zero(), V2::zero(), Ang<2>::zero(), Rb, kDensity, 0, 0, kFrozen);
+            w.particles.addPolygon(V2{{0, Rb + kR * std::sqrt(3.0) / 2}}, V2::zero(), Ang<2>::zero(), 0.0,
+                                   polygon::regularPolygon(6, kR, 0.0), kDensity, 0, 1);
+        } else {
+            w.particles.addPolygon(V2::zero(), V2::zero(), Ang<2>::zero(), 0.0, polygon::rectangle(4.0, Rb, 0.0),
+                                   kDensity, 0, 0, kFrozen);
+            const double top = Rb / std::sqrt(17.0);
+            w.particles.add(V2{{0.001, top + kR}}, V2::zero(), Ang<2>::zero(), kR, kDensity, 0, 1);
+        }
+        w.contact = buildContactSetup(sc, materialStats(w.particles, 1));
+        TdmSettings s;
+        s.integrator = IntegratorKind::Gear5;
+        s.dt = w.contact.polygonStep;
+        s.skin = 0.2 * kR;
+        s.sortEvery = 0;
+        TdmEngine<2> eng(w, s);
+        eng.advanceTo(0.15);
+        const Particles<2>& p = w.particles;
+        const std::size_t top = p.id[0] == 1 ? 0 : 1, base = 1 - top;
+        // The polygon's outline relative to the disk's centre, then the overlap.
+        const std::size_t poly = polygonOnTop ? top : base, disk = polygonOnTop ? base : top;
+        std::vector<V2> outline;
+        const V2* b = p.shapes.of(p.shape[poly]);
+        for (int k = 0; k < p.shapes.count(p.shape[poly]); ++k)
+            outline.push_back(polygon::rotate(b[k], std::cos(p.angle[poly][0]), std::sin(p.angle[poly][0])) +
+                              p.x[poly] - p.x[disk]);
+        const polygon::Overlap o = polygon::circlePolygonOverlap(p.radius[disk], outline.data(), int(outline.size()));
+        const double li = norm(o.centroid + p.x[disk] - p.x[poly]), lj = norm(o.centroid);
+        const double l = 4 * li * lj / (li + lj);
+        const double mg = p.mass[top] * 9.81;
+        EXPECT_NEAR(kYoung * o.area / l, mg, 1e-6 * mg) << (polygonOnTop ? "hexagon on a disk" : "disk on a block");
+        EXPECT_LT(norm(p.v[top]), 1e-8);
+        EXPECT_GT(p.x[top][1], 0.0);
+    }
+}
+
 struct SlopeResult {
     double accel = 0;    ///< least-squares acceleration along the slope over the window [m/s^2]
     double travel = 0;   ///< distance along the slope over the window [m]
