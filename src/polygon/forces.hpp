@@ -75,10 +75,9 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
         const V2* a = ps.rotated.data() + st.first[si];
         const V2* b = ps.rotated.data() + st.first[sj];
         // Broad phase passed (bounding circles): the line of centres separates most remaining pairs cheaply (P's
-        // projections are a's shifted by |d|); the clipping finds that the others do not overlap (the full
-        // separating-axis test would cost about as much as the clipping).
-        const double dl = std::sqrt(dist2);
-        if (dl > 0 && separatedAlong(d / dl, dl, a, np, b, nq)) {
+        // projections on d are a's shifted by |d|^2); the clipping finds that the others do not overlap (the full
+        // separating-axis test, polygon::separated, would cost about as much as the clipping).
+        if (dist2 > 0 && separatedAlong(d, dist2, a, np, b, nq)) {
             if (!(hist == V2::zero())) hist = V2::zero();
             return false;
         }

@@ -180,9 +180,9 @@ inline bool separated(const V2* P, int np, const V2* Q, int nq) {
     return byEdgesOf(P, np, Q, nq) || byEdgesOf(Q, nq, P, np);
 }
 
-/// True when the projections on the unit direction `u` of P shifted by `shift` u and of Q do not overlap (touching
-/// counts as apart). The line of centres is the axis that separates most non-touching pairs of a cell list, at
-/// n + m dot products.
+/// True when the projections on the direction `u` (any length) of P shifted by a vector whose projection is `shift`
+/// and of Q do not overlap (touching counts as apart). The line of centres is the axis that separates most
+/// non-touching pairs of a cell list, at n + m dot products.
 inline bool separatedAlong(const V2& u, double shift, const V2* P, int np, const V2* Q, int nq) {
     double minP = dot(P[0], u), maxQ = dot(Q[0], u);
     for (int k = 1; k < np; ++k) minP = std::min(minP, dot(P[k], u));
