@@ -7,6 +7,8 @@
 # 2. bench/compare_lammps.sh BUILD_DIR 2d   the same in 2D (8 000 disks)
 # 3. bench/haet_compare.sh BUILD_DIR        the hybrid against pure TDM and EDM (demo), dilute-fraction sweep
 # 4. BUILD_DIR/haet_bench                   Google Benchmark micro-benchmarks, when built
+# 5. BUILD_DIR/haet_bench PolygonSettle2D   10 000 hexagons vs 10 000 disks settling, 1 and 2 threads, side by
+#                                           side in one run, with the polygon/disk cost ratio
 # The first run on a machine prepares the flowing states with LAMMPS (10-15 min for 3D, once; kept in
 # bench/data/). Installs the Debian packages lammps and time when missing. Exits non-zero when any part failed,
 # after running the others.
@@ -40,7 +42,25 @@ echo
 
 if [ -x "$build/haet_bench" ]; then
     echo "=== micro-benchmarks: $build/haet_bench"
-    "$build/haet_bench" --benchmark_min_time=0.5 || failed="$failed haet_bench"
+    "$build/haet_bench" --benchmark_min_time=0.5 --benchmark_filter='^Edm' || failed="$failed haet_bench"
+    echo
+    echo "=== polygons vs disks: 10 000 hexagons / disks settling in a box (bench/polygon_settle.cpp)"
+    csv=$(mktemp)
+    if "$build/haet_bench" --benchmark_filter='^PolygonSettle2D' --benchmark_format=csv > "$csv"; then
+        # particle_steps_per_s is the 12th CSV column; names look like "PolygonSettle2D/hexagons/1/...".
+        awk -F, 'NR > 1 && $1 ~ /PolygonSettle2D/ {
+                     split($1, part, "/"); gsub(/"/, "", part[2]); rate[part[2] "/" part[3]] = $12 }
+                 END {
+                     for (t = 1; t <= 2; ++t) {
+                         h = rate["hexagons/" t]; d = rate["disks/" t]
+                         printf "threads %d: hexagons %.3g polygon-steps/s, disks %.3g disk-steps/s, " \
+                                "polygon step / disk step = %.2f\n", t, h, d, (h > 0 ? d / h : 0)
+                     }
+                 }' "$csv"
+    else
+        failed="$failed polygon_settle"
+    fi
+    rm -f "$csv"
 else
     echo "=== micro-benchmarks: $build/haet_bench not built (needs libbenchmark-dev and bench/*.cpp); skipped"
 fi

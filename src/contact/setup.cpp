@@ -99,6 +99,7 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
     const int nm = static_cast<int>(sc.materials.size());
     s.nMaterials = nm;
     s.table.resize(nm * nm);
+    s.polygonTable.resize(nm * nm);
     const double q = sc.dimension == 2 ? 0.5 : 0.4;
 
     // Reference particle of each material (materials without particles borrow the overall mean).
@@ -141,7 +142,7 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
                         // gamma_n = -2 ln(e) sqrt(m_eff k_n / (pi^2 + ln^2 e)): exact for the reference pair
                         c.gnPerMeff = -2 * lne * std::sqrt(*cd.kn / (meffRef * (kPi * kPi + lne * lne)));
                     }
-                } else {
+                } else if (cd.duration) {
                     const double tc = *cd.duration;
                     c.knPerMeff = (kPi * kPi + lne * lne) / (tc * tc);
                     c.gnPerMeff = -2 * lne / tc;
@@ -183,10 +184,25 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
                 c.gtPerMeff = cd.gammaT;
             }
             // The restitution the soft law really produces (contact-ending rule included), for the EDM.
-            c.restitution = simulateHeadOn(s.normal, s.hertzDamping, c, meffRef, reffRef, cd.impactVelocity,
-                                           cd.attraction)
-                                .restitution;
+            // (A polygon-only scene may leave the linear law without coefficients: nothing to simulate.)
+            const bool haveDiskLaw = cd.normal == NormalLaw::Hertz || cd.kn || cd.duration;
+            c.restitution = haveDiskLaw ? simulateHeadOn(s.normal, s.hertzDamping, c, meffRef, reffRef,
+                                                         cd.impactVelocity, cd.attraction)
+                                              .restitution
+                                        : e;
             s.table[a * nm + b] = c;
+
+            // Polygon law (PHYSICS.md G.3). Damping from e: for a flat contact as wide as l the law is a linear
+            // spring-dashpot with damping ratio gamma/2, so gamma = 2 (-ln e)/sqrt(pi^2 + ln^2 e) gives e there.
+            polygon::PolygonCoeffs pc;
+            pc.young = 2 * ma.young * mb.young / (ma.young + mb.young);
+            pc.gamma = cd.polygonDamping ? *cd.polygonDamping : -2 * lne / std::sqrt(kPi * kPi + lne * lne);
+            pc.mu = c.mu;
+            if (cd.tangential == TangentialLaw::Spring) {
+                pc.kt = cd.kt ? *cd.kt : (cd.ktRatio ? *cd.ktRatio : 2.0 / 7.0) * pc.young;
+                pc.gammaT = e < 1 ? 0.25 : 0.0;  // Matuttis-Chen's 0.25 sqrt(k_t m_t); none in an elastic scene
+            }
+            s.polygonTable[a * nm + b] = pc;
         }
     }
 
@@ -208,11 +224,39 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
             }
         }
     s.contactTime = tc;
+    s.diskContactTime = tc;
     if (cd.normal == NormalLaw::Linear)
         s.contactTimeNote = cd.kn ? "linear law, fixed k_n: t_c = pi/omega of the lightest pair"
                                   : "linear law: t_c as given";
     else
         s.contactTimeNote = "Hertz: t_c = 2.868 (m_eff^2/(R_eff E_eff^2 v))^(1/5) of the smallest pair at impact_velocity";
+
+    // Polygons: the thesis rule dt = (pi/10) sqrt(m_min/Y) (PHYSICS.md F.3), with the stiffest pair's Y; their
+    // contact time is about ten such steps. The rule assumes light damping: the Gear corrector sees the damping
+    // force through the predicted velocity and turns unstable once the damping rate per step, gamma (w/l)
+    // sqrt(Y/m) dt, exceeds about 0.15 (damped oscillator: stable at 2 zeta omega dt = 0.12, unstable at 0.18; a
+    // flat contact has w/l up to ~1.5). So for gamma > 0.2 (e < 0.73) the step shrinks by 0.2/gamma.
+    std::size_t polygons = 0;
+    double mPoly = 0;
+    for (const auto& st : stats)
+        if (st.polygons) {
+            mPoly = polygons ? std::min(mPoly, st.minPolygonMass) : st.minPolygonMass;
+            polygons += st.polygons;
+        }
+    if (polygons > 0) {
+        double yMax = 0, gMax = 0;
+        for (const auto& pc : s.polygonTable) {
+            yMax = std::max(yMax, pc.young);
+            gMax = std::max(gMax, pc.gamma);
+        }
+        s.polygonStepFactor = std::min(1.0, 0.2 / gMax);
+        s.polygonStep = kPi / 10 * std::sqrt(mPoly / yMax) * s.polygonStepFactor;
+        const double tcPoly = kPi * std::sqrt(mPoly / yMax);
+        if (polygons == all.count || !(tcPoly >= s.contactTime)) {
+            s.contactTime = polygons == all.count ? tcPoly : std::min(s.contactTime, tcPoly);
+            s.contactTimeNote = "polygons: t_c ~ pi sqrt(m_min/Y) of the lightest polygon";
+        }
+    }
     return s;
 }
 

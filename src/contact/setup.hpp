@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "contact/laws.hpp"
+#include "polygon/contact.hpp"
 #include "scenario/definition.hpp"
 
 namespace haet {
@@ -16,6 +17,8 @@ struct MaterialStats {
     std::size_t count = 0;
     double meanRadius = 0, meanMass = 0;  ///< [m], [kg]
     double minRadius = 0, minMass = 0;    ///< [m], [kg]
+    std::size_t polygons = 0;             ///< how many of them are polygons (2D)
+    double minPolygonMass = 0;            ///< lightest polygon [kg] (0 when there is none)
 };
 
 struct ContactSetup {
@@ -28,7 +31,19 @@ struct ContactSetup {
     double contactTime = 0;         ///< shortest contact duration among particle pairs and walls [s]
     std::string contactTimeNote;    ///< how contactTime was obtained (for `haet check`)
 
+    /// Overlap-area law of polygon contacts (PHYSICS.md G.3), nMaterials x nMaterials; used for every contact
+    /// that involves a polygon. Y_ab = 2 Y_a Y_b / (Y_a + Y_b) from the materials' `young`.
+    std::vector<polygon::PolygonCoeffs> polygonTable;
+    /// Polygon time-step rule (PHYSICS.md F.3): (pi/10) sqrt(m_min / Y_max) over polygon particles [s]; 0 when the
+    /// scene has no polygon.
+    double polygonStep = 0;
+    double polygonStepFactor = 1;  ///< the factor min(1, 0.2/gamma) in polygonStep (strong damping) [-]
+    /// Contact duration of the disk law alone [s] (infinite when it has no coefficients): with polygons present,
+    /// contactTime is the shorter of this and the polygons' pi sqrt(m_min/Y).
+    double diskContactTime = 0;
+
     const PairCoeffs& pair(int a, int b) const { return table[a * nMaterials + b]; }
+    const polygon::PolygonCoeffs& polygonPair(int a, int b) const { return polygonTable[a * nMaterials + b]; }
 };
 
 /// Builds the coefficient table. stats has one entry per material (count 0 for wall-only materials).

@@ -1,5 +1,7 @@
 #pragma once
 // The one particle store shared by every engine: structure-of-arrays, ordered for the force loop.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -16,6 +18,22 @@ enum ParticleFlag : std::uint8_t {
 /// Shape factor q of the moment of inertia I = q m a^2 (PHYSICS.md B.4): solid disk 1/2, solid sphere 2/5.
 template <int D>
 inline constexpr double kInertiaFactor = (D == 2) ? 0.5 : 0.4;
+
+/// Shape index of a particle that is a disk or sphere (Particles::shape).
+inline constexpr std::uint32_t kNoShape = 0xffffffffu;
+
+/// Shapes of the polygon particles (2D): vertex lists in the body frame, one entry per polygon particle.
+/// Rotating the body frame by Particles::angle and moving it to Particles::x gives the polygon in the world.
+struct ShapeTable {
+    std::vector<std::uint32_t> first{0};  ///< CSR: shape s owns vertices [first[s], first[s+1])
+    std::vector<Vec<2>> vertices;         ///< centroid at the origin, counter-clockwise [m]
+    std::vector<double> inertiaPerMass;   ///< moment of inertia about the centroid / mass [m^2]
+    std::vector<double> area;             ///< [m^2]
+
+    std::size_t size() const { return area.size(); }
+    int count(std::uint32_t s) const { return int(first[s + 1] - first[s]); }
+    const Vec<2>* of(std::uint32_t s) const { return vertices.data() + first[s]; }
+};
 
 template <int D>
 struct Particles {
@@ -35,6 +53,9 @@ struct Particles {
     std::vector<Ang<D>> angle;    ///< accumulated rotation angle [rad] (2D: orientation)
     std::vector<std::uint64_t> id;  ///< stable user-visible id (survives reordering)
     std::vector<Vec<D>> image;    ///< accumulated periodic wraps, for unwrapped positions [m]
+    // polygons (2D only). Empty while the store holds no polygon, so disk and sphere runs carry nothing extra.
+    std::vector<std::uint32_t> shape;  ///< index into `shapes`, kNoShape for a disk
+    ShapeTable shapes;                 ///< never permuted: particles point into it
 
     /// Particles [0, tdmCount()) are integrated by the time-driven engine. In a hybrid run the rest belong to the
     /// event-driven engine (PHYSICS.md A); in a pure run one engine owns them all (the default: every particle).
@@ -62,8 +83,61 @@ struct Particles {
         angle.push_back(Ang<D>::zero());
         id.push_back(pid);
         image.push_back(Vec<D>::zero());
+        if (!shape.empty()) shape.push_back(kNoShape);
         return x.size() - 1;
     }
+
+    /// Appends one convex polygon (2D only) with its centroid at `pos`, turned by `orientation` [rad]. `body`:
+    /// the vertices in the body frame [m], convex, in either order, about any origin (they are re-centred on
+    /// their centroid and put counter-clockwise). The radius becomes the circumradius about the centroid (the
+    /// bounding circle the neighbour grid uses), mass and moment of inertia follow from the vertices.
+    std::size_t addPolygon(const Vec<D>& pos, const Vec<D>& vel, const Ang<D>& spin, double orientation,
+                           std::vector<Vec<2>> body, double density, std::uint16_t mat, std::uint64_t pid,
+                           std::uint8_t flag = 0) {
+        static_assert(D == 2, "polygons exist only in 2D");
+        double a2 = 0, mx = 0, my = 0;
+        const std::size_t nv = body.size();
+        for (std::size_t k = 0; k < nv; ++k) {
+            const Vec<2>& p = body[k];
+            const Vec<2>& q = body[(k + 1) % nv];
+            const double cr = p[0] * q[1] - q[0] * p[1];
+            a2 += cr;
+            mx += (p[0] + q[0]) * cr;
+            my += (p[1] + q[1]) * cr;
+        }
+        if (a2 < 0) {
+            std::reverse(body.begin(), body.end());
+            a2 = -a2, mx = -mx, my = -my;
+        }
+        const Vec<2> c{{mx / (3 * a2), my / (3 * a2)}};
+        double r2 = 0, io = 0;
+        for (Vec<2>& p : body) p -= c;
+        for (std::size_t k = 0; k < nv; ++k) {
+            const Vec<2>& p = body[k];
+            const Vec<2>& q = body[(k + 1) % nv];
+            const double cr = p[0] * q[1] - q[0] * p[1];
+            io += cr * (p[0] * p[0] + p[0] * q[0] + q[0] * q[0] + p[1] * p[1] + p[1] * q[1] + q[1] * q[1]);
+            r2 = std::max(r2, norm2(p));
+        }
+        const double area = 0.5 * a2;
+        const std::size_t i = add(pos, vel, spin, std::sqrt(r2), density, mat, pid, flag);
+        shape.resize(x.size(), kNoShape);  // the first polygon turns the disks before it into kNoShape entries
+        const double m = density * area;
+        const double ipm = (io / 12.0) / area;  // about the centroid, which is now the origin
+        mass[i] = m;
+        invMass[i] = (flag & kFrozen) ? 0.0 : 1.0 / m;
+        invInertia[i] = (flag & kFrozen) ? 0.0 : 1.0 / (ipm * m);
+        angle[i][0] = orientation;
+        shape[i] = static_cast<std::uint32_t>(shapes.size());
+        shapes.vertices.insert(shapes.vertices.end(), body.begin(), body.end());
+        shapes.first.push_back(static_cast<std::uint32_t>(shapes.vertices.size()));
+        shapes.inertiaPerMass.push_back(ipm);
+        shapes.area.push_back(area);
+        return i;
+    }
+
+    bool hasPolygons() const { return !shape.empty(); }
+    bool isPolygon(std::size_t i) const { return !shape.empty() && shape[i] != kNoShape; }
 
     /// Volume of a sphere (3D) or area of a disk (2D) of radius r.
     static double volumeOf(double r) {
@@ -71,7 +145,10 @@ struct Particles {
         return (D == 2) ? pi * r * r : (4.0 / 3.0) * pi * r * r * r;
     }
 
-    double inertia(std::size_t i) const { return kInertiaFactor<D> * mass[i] * radius[i] * radius[i]; }
+    double inertia(std::size_t i) const {
+        if (isPolygon(i)) return shapes.inertiaPerMass[shape[i]] * mass[i];
+        return kInertiaFactor<D> * mass[i] * radius[i] * radius[i];
+    }
     bool frozen(std::size_t i) const { return flags[i] & kFrozen; }
 
     /// Exchanges particles i and j (all fields).
@@ -92,6 +169,7 @@ struct Particles {
         };
         apply(x); apply(v); apply(w); apply(f); apply(torque); apply(radius); apply(invMass);
         apply(invInertia); apply(material); apply(flags); apply(mass); apply(angle); apply(id); apply(image);
+        if (!shape.empty()) apply(shape);
     }
 };
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <fmt/format.h>
 #include <omp.h>
 #include <ostream>
@@ -19,6 +20,7 @@
 #include "io/vtk.hpp"
 #include "edm/engine.hpp"
 #include "haet/engine.hpp"
+#include "polygon/output.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
 
@@ -267,6 +269,14 @@ public:
         writeVtuPoints(dir_ / name, n, xyz.data(), fields, time);
         pvd_.add(time, name);
         if (hybrid) writeZones(*hybrid, time);
+        if constexpr (D == 2) {
+            if (p.hasPolygons()) {  // the real shapes, as polygon cells (polygons.pvd)
+                if (!polys_) polys_.emplace(dir_ / "polygons.pvd");
+                const std::string pname = fmt::format("polygons_{:06d}.vtu", count_);
+                polygon::writePolygonVtu(dir_ / pname, p, time);
+                polys_->add(time, pname);
+            }
+        }
         if (!w.walls.empty()) {
             const std::string wname = fmt::format("walls_{:06d}.vtp", count_);
             writeVtpWalls(dir_ / wname, wallQuads(w, time));
@@ -341,6 +351,7 @@ private:
 
     std::filesystem::path dir_;
     PvdCollection pvd_, walls_, zones_;
+    std::optional<PvdCollection> polys_;
     int count_ = 0;
 };
 
@@ -367,7 +378,10 @@ void writePicture(const World<2>& w, const std::filesystem::path& path, bool byM
             const auto r = static_cast<std::uint32_t>(60 + 195 * s), b = static_cast<std::uint32_t>(255 - 195 * s);
             colour = (r << 16) | (90u << 8) | b;
         }
-        scene.disks.push_back({p.x[i][0], p.x[i][1], p.radius[i], colour});
+        if (p.isPolygon(i))
+            scene.polygons.push_back({polygon::worldOutline(p, i), colour});
+        else
+            scene.disks.push_back({p.x[i][0], p.x[i][1], p.radius[i], colour});
     }
     for (const Wall<2>& wl : w.walls) {
         const Vec<2> pt = wl.pointAt(w.time);
@@ -533,6 +547,9 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
                        std::count_if(world.particles.flags.begin(), world.particles.flags.end(),
                                      [](std::uint8_t f) { return f & kFrozen; }),
                        sc.materials.size(), world.walls.size());
+    if (world.particles.hasPolygons())
+        out << fmt::format("polygons   {} (overlap-area law, PHYSICS.md G.3; the rest are disks)\n",
+                           world.particles.shapes.size());
     out << fmt::format("contact    {} normal law, {} tangential; contact duration t_c = {:.4g} s ({})\n",
                        sc.contact.normal == NormalLaw::Linear ? "linear" : "hertz",
                        sc.contact.tangential == TangentialLaw::Spring ? "spring" : "no",

@@ -20,6 +20,8 @@ enum class TangentialLaw { None, Spring };
 enum class IntegratorKind { Verlet, Gear5 };
 enum class Arrangement { Lattice, Random, File };
 enum class FileFormat { Csv, LammpsData };
+enum class ShapeKind { Disk, Polygon };
+enum class PolygonKind { Regular, Rectangle, Random };
 
 /// Where a value came from, for error messages: file and 1-based line (0 when unknown).
 struct SourcePos {
@@ -79,11 +81,14 @@ struct ContactDef {
     double gammaT = 0;             ///< tangential damping, LAMMPS convention [1/s]
     bool attraction = false;       ///< false: normal force clipped at zero (no attraction while separating)
     double impactVelocity = 1.0;   ///< Hertz: impact speed used for t_c and the time-step rule [m/s]
+    /// Polygon contacts: dimensionless normal damping gamma of PHYSICS.md G.3; default from the restitution
+    std::optional<double> polygonDamping;
     SourcePos pos;
 };
 
 struct TdmDef {
     IntegratorKind integrator = IntegratorKind::Verlet;
+    bool integratorGiven = false;  ///< false: the default applies (verlet; gear5 in scenes with polygons)
     std::optional<double> dt;      ///< time step [s]; unset = "auto": t_c / steps_per_contact
     double stepsPerContact = 50;   ///< auto rule: dt = t_c / steps_per_contact [-]
     std::optional<double> skin;    ///< Verlet-list skin [m]; default 0.1 x smallest diameter... see docs
@@ -137,6 +142,12 @@ struct InsertDef {
     std::string file;                  ///< arrangement = File: path (resolved against the scenario dir)
     FileFormat format = FileFormat::Csv;
     std::vector<int> frozenTypes;      ///< LAMMPS data files: atom types (1-based) whose particles are frozen
+    // Polygons (2D, PHYSICS.md G). `radius` is then the circumradius about the centroid (the bounding circle).
+    ShapeKind shape = ShapeKind::Disk;
+    PolygonKind polygon = PolygonKind::Regular;
+    int sidesMin = 0, sidesMax = 0;    ///< vertices per polygon, uniform in [min, max] (regular: min = max)
+    double aspect = 1;                 ///< rectangle: side ratio (x over y) [-]; random: largest stretch [-]
+    std::optional<double> orientation; ///< [rad]; unset = uniform random in [0, 2 pi)
     SourcePos pos;
 };
 

@@ -1,6 +1,8 @@
 #include "scenario/insert.hpp"
 #include "scenario/text.hpp"
 
+#include "polygon/geometry.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -189,7 +191,28 @@ struct NewParticle {
     std::uint16_t material = 0;
     std::uint8_t flags = 0;
     Vec<D> image{};
+    std::vector<Vec<2>> body;  ///< polygon vertices in the body frame [m]; empty for a disk or sphere
+    double orientation = 0;    ///< polygon angle [rad]
+
+    double mass() const {
+        if (body.empty()) return density * Particles<D>::volumeOf(radius);
+        return density * polygon::polygonMoments(body.data(), int(body.size())).area;
+    }
 };
+
+/// The polygon of an insert with shape = "polygon", circumradius r, drawn after the particle's position.
+template <int D>
+void makePolygon(const InsertDef& in, NewParticle<D>& p, Rng& rng) {
+    if (in.shape != ShapeKind::Polygon) return;
+    const double twoPi = 2 * 3.14159265358979323846;
+    const int sides = in.sidesMin + int(rng.uniform() * (in.sidesMax - in.sidesMin + 1));
+    p.orientation = in.orientation ? *in.orientation : rng.uniform(0, twoPi);
+    switch (in.polygon) {
+        case PolygonKind::Regular: p.body = polygon::regularPolygon(sides, p.radius, 0.0); break;
+        case PolygonKind::Rectangle: p.body = polygon::rectangle(in.aspect, p.radius, 0.0); break;
+        case PolygonKind::Random: p.body = polygon::randomConvexPolygon(rng, sides, p.radius, in.aspect, 0.0); break;
+    }
+}
 
 /// A grid over the insert's region, expanded by one cell, holding the store's particles that could touch it.
 template <int D>
@@ -224,7 +247,7 @@ void assignVelocities(const InsertDef& in, std::vector<NewParticle<D>>& out, Rng
     Vec<D> momentum = Vec<D>::zero();  // of the thermal part [kg m/s]
     double massSum = 0;
     for (const auto& p : out) {
-        const double m = p.density * Particles<D>::volumeOf(p.radius);
+        const double m = p.mass();
         momentum += m * (p.v - mean);
         massSum += m;
     }
@@ -259,6 +282,7 @@ std::vector<NewParticle<D>> insertLattice(const Scenario& s, std::size_t k, cons
             p.x[a] = std::min(lo[a] + in.radiusMax + double(site[a]) * spacing, hi[a] - in.radiusMax);
         p.radius = rng.uniform(in.radiusMin, in.radiusMax);
         if (clearOfWalls(s.walls, p.x, p.radius) && !grid.overlaps(p.x, p.radius)) {
+            makePolygon(in, p, rng);
             p.density = mat.density;
             p.material = std::uint16_t(in.material);
             p.flags = in.frozen ? kFrozen : 0;
@@ -300,6 +324,7 @@ std::vector<NewParticle<D>> insertRandom(const Scenario& s, std::size_t k, const
                                     " particles without overlap: region too small (placed " + std::to_string(i) +
                                     " in " + std::to_string(attempts) + " attempts)");
         grid.add(p.x, p.radius);
+        makePolygon(in, p, rng);
         p.density = mat.density;
         p.material = std::uint16_t(in.material);
         p.flags = in.frozen ? kFrozen : 0;
@@ -310,8 +335,37 @@ std::vector<NewParticle<D>> insertRandom(const Scenario& s, std::size_t k, const
 }
 
 template <int D>
+std::vector<NewParticle<D>> insertPolygonsFromFile(const Scenario& s, std::size_t k) {
+    const InsertDef& in = s.inserts[k];
+    const std::string key = insertKey(k) + ".file";
+    std::vector<NewParticle<D>> out;
+    for (const FilePolygon& fp : readPolygonCsv(in.file, s.materials, key)) {
+        NewParticle<D> p;
+        const polygon::Moments m = polygon::polygonMoments(fp.vertices.data(), int(fp.vertices.size()));
+        for (int a = 0; a < D; ++a) {
+            p.x[a] = m.centroid[a];
+            if (p.x[a] < s.domain.lo[std::size_t(a)] || p.x[a] > s.domain.hi[std::size_t(a)])
+                throw ScenarioError({in.file, fp.line}, key, "polygon centroid lies outside the domain");
+            p.v[a] = fp.v[std::size_t(a)];
+        }
+        p.w[0] = fp.w;
+        p.body = fp.vertices;
+        for (Vec<2>& v : p.body) v -= m.centroid;
+        p.radius = polygon::circumradius(p.body.data(), int(p.body.size()), Vec<2>::zero());
+        const int mat = fp.material >= 0 ? fp.material : in.material;
+        p.material = std::uint16_t(mat);
+        p.density = s.materials[std::size_t(mat)].density;
+        p.flags = (in.frozen || fp.frozen) ? kFrozen : 0;
+        out.push_back(p);
+    }
+    return out;
+}
+
+template <int D>
 std::vector<NewParticle<D>> insertFromFile(const Scenario& s, std::size_t k) {
     const InsertDef& in = s.inserts[k];
+    if constexpr (D == 2)
+        if (in.shape == ShapeKind::Polygon) return insertPolygonsFromFile<D>(s, k);
     const std::string key = insertKey(k) + ".file";
     const ParticleFile pf =
         in.format == FileFormat::Csv ? readParticleCsv(in.file, D, s.materials, key) : readLammpsData(in.file, key);
@@ -442,6 +496,94 @@ ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
     }
     if (!haveHeader) throw ScenarioError({name, 0}, key, "empty particle file: no header line");
     if (out.particles.empty()) throw ScenarioError({name, int(lines.size())}, key, "the file holds no particles");
+    return out;
+}
+
+std::vector<FilePolygon> readPolygonCsv(const std::filesystem::path& file, const std::vector<MaterialDef>& materials,
+                                        const std::string& key) {
+    const std::string name = file.string();
+    const std::vector<std::string> lines = readLines(file, key);
+    enum Column { Vertices, Vx, Vy, W, Material, Frozen, kColumns };
+    const char* const columnName[kColumns] = {"vertices", "vx", "vy", "w", "material", "frozen"};
+    std::array<int, kColumns> col;
+    col.fill(-1);
+    std::size_t fields = 0;
+    bool haveHeader = false;
+    std::vector<FilePolygon> out;
+    for (std::size_t li = 0; li < lines.size(); ++li) {
+        const int lineNo = int(li + 1);
+        const std::string_view line = trim(lines[li]);
+        if (line.empty() || line[0] == '#') continue;
+        auto fail = [&](const std::string& what) { throw ScenarioError({name, lineNo}, key, what); };
+        const std::vector<std::string_view> cells = splitOn(line, ',');
+        if (!haveHeader) {
+            haveHeader = true;
+            fields = cells.size();
+            for (std::size_t c = 0; c < cells.size(); ++c) {
+                int which = -1;
+                for (int j = 0; j < kColumns; ++j)
+                    if (cells[c] == columnName[j]) which = j;
+                if (which < 0)
+                    fail("unknown column " + inQuotes(cells[c]) +
+                         " (a polygon file names columns vertices, vx, vy, w, material, frozen)");
+                if (col[std::size_t(which)] >= 0) fail("column " + inQuotes(cells[c]) + " appears twice");
+                col[std::size_t(which)] = int(c);
+            }
+            if (col[Vertices] < 0) fail("missing column \"vertices\"");
+            if ((col[Vx] >= 0) != (col[Vy] >= 0)) fail("velocity columns vx, vy go together");
+            continue;
+        }
+        if (cells.size() != fields)
+            fail("expected " + std::to_string(fields) + " fields, got " + std::to_string(cells.size()));
+        FilePolygon p;
+        p.line = lineNo;
+        auto number = [&](Column c) {
+            const std::string_view text = cells[std::size_t(col[c])];
+            const auto v = parseDouble(text);
+            if (!v) fail(std::string("column ") + columnName[c] + ": expected a number, got " + inQuotes(text));
+            return *v;
+        };
+        const std::vector<std::string_view> coords = whitespaceTokens(cells[std::size_t(col[Vertices])]);
+        if (coords.size() % 2 != 0 || coords.size() < 6 || coords.size() > 2 * polygon::kMaxVertices)
+            fail("column vertices: expected 3 to " + std::to_string(polygon::kMaxVertices) +
+                 " vertices as \"x0 y0 x1 y1 ...\", got " + std::to_string(coords.size()) + " numbers");
+        for (std::size_t c = 0; c < coords.size(); c += 2) {
+            const auto x = parseDouble(coords[c]), y = parseDouble(coords[c + 1]);
+            if (!x || !y) fail("column vertices: expected numbers, got " + inQuotes(!x ? coords[c] : coords[c + 1]));
+            p.vertices.push_back(Vec<2>{{*x, *y}});
+        }
+        if (polygon::polygonMoments(p.vertices.data(), int(p.vertices.size())).area < 0)
+            std::reverse(p.vertices.begin(), p.vertices.end());
+        if (!polygon::isConvexCcw(p.vertices.data(), int(p.vertices.size())))
+            fail("column vertices: the polygon is not convex (or has repeated or collinear vertices)");
+        if (col[Vx] >= 0) {
+            p.v[0] = number(Vx);
+            p.v[1] = number(Vy);
+        }
+        if (col[W] >= 0) p.w = number(W);
+        if (col[Material] >= 0) {
+            const std::string_view text = cells[std::size_t(col[Material])];
+            for (std::size_t m = 0; m < materials.size(); ++m)
+                if (materials[m].name == text) p.material = int(m);
+            if (p.material < 0) {
+                const auto idx = parseInteger(text);
+                if (idx && *idx >= 0 && std::size_t(*idx) < materials.size()) p.material = int(*idx);
+            }
+            if (p.material < 0) fail("column material: unknown material " + inQuotes(text));
+        }
+        if (col[Frozen] >= 0) {
+            const std::string_view text = cells[std::size_t(col[Frozen])];
+            if (text == "1" || text == "true")
+                p.frozen = true;
+            else if (text == "0" || text == "false")
+                p.frozen = false;
+            else
+                fail("column frozen: expected 0, 1, true or false, got " + inQuotes(text));
+        }
+        out.push_back(std::move(p));
+    }
+    if (!haveHeader) throw ScenarioError({name, 0}, key, "empty polygon file: no header line");
+    if (out.empty()) throw ScenarioError({name, int(lines.size())}, key, "the file holds no polygons");
     return out;
 }
 
@@ -613,8 +755,15 @@ void insertParticles(const Scenario& s, Particles<D>& particles, Rng rng) {
         }
         // Added only once the whole insert succeeded, so a failed insert leaves no partial block behind.
         for (const auto& p : out) {
-            const std::size_t i =
-                particles.add(p.x, p.v, p.w, p.radius, p.density, p.material, particles.size(), p.flags);
+            std::size_t i;
+            if constexpr (D == 2) {
+                i = p.body.empty()
+                        ? particles.add(p.x, p.v, p.w, p.radius, p.density, p.material, particles.size(), p.flags)
+                        : particles.addPolygon(p.x, p.v, p.w, p.orientation, p.body, p.density, p.material,
+                                               particles.size(), p.flags);
+            } else {
+                i = particles.add(p.x, p.v, p.w, p.radius, p.density, p.material, particles.size(), p.flags);
+            }
             particles.image[i] = p.image;
         }
     }

@@ -34,6 +34,22 @@ struct ParticleFile {
     int atomTypes = 0;                    ///< LAMMPS "atom types" count; 0 for CSV
 };
 
+/// One polygon as read from a polygon CSV file (2D), SI units.
+struct FilePolygon {
+    std::vector<Vec<2>> vertices;  ///< world coordinates [m], counter-clockwise, convex
+    Vec3d v{0, 0, 0};              ///< velocity [m/s]
+    double w = 0;                  ///< angular velocity [rad/s]
+    int material = -1;             ///< index into Scenario::materials; -1: the insert's material
+    bool frozen = false;
+    int line = 0;                  ///< line of the file, for messages
+};
+
+/// Reads a polygon CSV file (insert with shape = "polygon", arrangement = "file"): a header naming the columns
+/// vertices[,vx,vy][,w][,material][,frozen] in any order; `vertices` holds "x0 y0 x1 y1 ..." (3 to 20 vertices, in
+/// either order, convex) in world coordinates. Errors: ScenarioError at the file's line, named `key`.
+std::vector<FilePolygon> readPolygonCsv(const std::filesystem::path& file, const std::vector<MaterialDef>& materials,
+                                        const std::string& key);
+
 /// Reads a CSV particle file whose header names the columns x,y[,z],radius[,vx,vy[,vz]][,material][,frozen] in any
 /// order (z and vz only in 3D). A material is a name from `materials` or its 0-based index; frozen is 0/1/true/false.
 /// Blank lines and lines starting with '#' are skipped. Errors: ScenarioError at the file's line, named `key`.

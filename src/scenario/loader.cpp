@@ -219,6 +219,7 @@ public:
         readHaet(s);
         readWalls(s);
         readInserts(s);
+        checkDiskLaw(s);
         readOutput(s);
         return s;
     }
@@ -319,7 +320,7 @@ private:
     void readContact(Scenario& s) {
         const TableReader r = child("contact");
         r.allowOnly({"normal", "duration", "kn", "gamma_n", "damping", "tangential", "kt", "kt_ratio", "gamma_t",
-                     "attraction", "impact_velocity"});
+                     "attraction", "impact_velocity", "polygon_damping"});
         ContactDef& c = s.contact;
         c.pos = r.tablePos();
         c.normal = r.choice<NormalLaw>("normal", {{"linear", NormalLaw::Linear}, {"hertz", NormalLaw::Hertz}})
@@ -329,8 +330,8 @@ private:
             c.kn = r.number("kn");
             c.gammaN = r.number("gamma_n");
             if (c.duration && c.kn) r.fail("kn", "not together with duration (give one of them)");
-            if (!c.duration && !c.kn)
-                r.fail("duration", "the linear law needs a contact duration (or kn); neither is given");
+            // Checked once the inserts are known (checkDiskLaw): a scene of polygons alone does not use it.
+            needDiskLaw_ = !c.duration && !c.kn;
             if (c.duration && !(*c.duration > 0)) r.fail("duration", "must be > 0");
             if (c.kn && !(*c.kn > 0)) r.fail("kn", "must be > 0");
             if (c.gammaN && !c.kn)
@@ -364,6 +365,17 @@ private:
         c.attraction = r.boolean("attraction").value_or(c.attraction);
         c.impactVelocity = r.number("impact_velocity").value_or(c.impactVelocity);
         if (!(c.impactVelocity > 0)) r.fail("impact_velocity", "must be > 0");
+        c.polygonDamping = r.number("polygon_damping");
+        if (c.polygonDamping && !(*c.polygonDamping >= 0)) r.fail("polygon_damping", "must be >= 0");
+    }
+
+    /// The linear law needs (duration or kn) as soon as the scene may hold disks: a disk insert or a particle file.
+    void checkDiskLaw(const Scenario& s) const {
+        if (!needDiskLaw_) return;
+        bool disks = s.inserts.empty();
+        for (const InsertDef& in : s.inserts) disks = disks || in.shape == ShapeKind::Disk;
+        if (disks)
+            child("contact").fail("duration", "the linear law needs a contact duration (or kn); neither is given");
     }
 
     void readTdm(Scenario& s) {
@@ -374,6 +386,7 @@ private:
         t.integrator = r.choice<IntegratorKind>("integrator",
                                                 {{"verlet", IntegratorKind::Verlet}, {"gear5", IntegratorKind::Gear5}})
                            .value_or(IntegratorKind::Verlet);
+        t.integratorGiven = r.has("integrator");
         if (const toml::node* n = r.table().get("dt")) {
             if (const auto* str = n->as_string()) {
                 if (str->get() != "auto") r.fail("dt", "must be \"auto\" or a number > 0");
@@ -465,12 +478,15 @@ private:
         for (std::size_t i = 0; i < inserts->size(); ++i) {
             const TableReader r(*inserts->get(i)->as_table(), "insert[" + std::to_string(i + 1) + "]", file_);
             s.inserts.push_back(readInsert(r));
+            if (s.inserts.back().shape == ShapeKind::Polygon && s.method != Method::Tdm)
+                r.fail("shape", "polygons need method = \"tdm\" (the event-driven engine handles disks and spheres)");
         }
     }
 
     InsertDef readInsert(const TableReader& r) const {
         r.allowOnly({"arrangement", "count", "radius", "material", "region", "spacing", "velocity", "temperature",
-                     "frozen", "file", "format", "frozen_types"});
+                     "frozen", "file", "format", "frozen_types", "shape", "polygon", "sides", "aspect",
+                     "orientation"});
         InsertDef in;
         in.pos = r.tablePos();
         in.arrangement = r.choice<Arrangement>("arrangement", {{"random", Arrangement::Random},
@@ -479,6 +495,7 @@ private:
                              .value_or(Arrangement::Random);
         in.material = materialIndex(r, "material");
         in.frozen = r.boolean("frozen").value_or(false);
+        readShape(r, in);
         if (r.has("frozen_types") && r.string("arrangement").value_or("random") != "file")
             r.fail("frozen_types", "only for arrangement = \"file\" with format = \"lammps\"");
 
@@ -495,6 +512,8 @@ private:
             in.file = p.string();
             in.format = r.choice<FileFormat>("format", {{"csv", FileFormat::Csv}, {"lammps", FileFormat::LammpsData}})
                             .value_or(FileFormat::Csv);
+            if (in.shape == ShapeKind::Polygon && in.format != FileFormat::Csv)
+                r.fail("format", "polygons are read from CSV files (format = \"csv\" with a vertices column)");
             if (in.format != FileFormat::LammpsData)
                 r.forbid("frozen_types", "only for format = \"lammps\" (a CSV file has a frozen column)");
             in.frozenTypes = r.integers("frozen_types", 1).value_or(std::vector<int>{});
@@ -529,6 +548,70 @@ private:
         in.temperature = r.number("temperature").value_or(0.0);
         if (!(in.temperature >= 0)) r.fail("temperature", "must be >= 0");
         return in;
+    }
+
+    /// shape, polygon, sides, aspect, orientation: which particles an insert makes (docs/scenario.md).
+    void readShape(const TableReader& r, InsertDef& in) const {
+        in.shape = r.choice<ShapeKind>("shape", {{"disk", ShapeKind::Disk}, {"polygon", ShapeKind::Polygon}})
+                       .value_or(ShapeKind::Disk);
+        if (in.shape == ShapeKind::Disk) {
+            for (const char* key : {"polygon", "sides", "aspect", "orientation"})
+                r.forbid(key, "only for shape = \"polygon\"");
+            return;
+        }
+        if (dim_ != 2) r.fail("shape", "polygons exist only in 2D (dimension = 2)");
+        const bool file = r.string("arrangement").value_or("random") == "file";
+        if (file) {
+            for (const char* key : {"polygon", "sides", "aspect", "orientation"})
+                r.forbid(key, "not used with arrangement = \"file\" (the file gives each polygon's vertices)");
+            return;
+        }
+        in.polygon = r.choice<PolygonKind>("polygon", {{"regular", PolygonKind::Regular},
+                                                       {"rectangle", PolygonKind::Rectangle},
+                                                       {"random", PolygonKind::Random}})
+                         .value_or(PolygonKind::Regular);
+        const int maxSides = 20;  // polygon::kMaxVertices
+        const std::string sidesRange = "must be an integer from 3 to " + std::to_string(maxSides);
+        if (in.polygon == PolygonKind::Rectangle) {
+            r.forbid("sides", "not for polygon = \"rectangle\" (4 sides)");
+            in.sidesMin = in.sidesMax = 4;
+        } else if (const toml::node* n = r.table().get("sides"); n && n->is_array()) {
+            if (in.polygon != PolygonKind::Random)
+                r.fail("sides", "a range [min, max] only for polygon = \"random\"; a regular polygon has one number");
+            const toml::array* a = n->as_array();
+            const auto* lo = a->size() == 2 ? a->get(0)->as_integer() : nullptr;
+            const auto* hi = a->size() == 2 ? a->get(1)->as_integer() : nullptr;
+            if (!lo || !hi) r.fail("sides", "expected an integer or an array [min, max] of 2 integers");
+            if (lo->get() < 3 || hi->get() > maxSides || lo->get() > hi->get())
+                r.fail("sides", "must satisfy 3 <= min <= max <= " + std::to_string(maxSides));
+            in.sidesMin = int(lo->get());
+            in.sidesMax = int(hi->get());
+        } else {
+            const auto sides = r.integer("sides");
+            if (!sides) r.fail("sides", "is required for polygon = \"" +
+                                            std::string(in.polygon == PolygonKind::Regular ? "regular" : "random") +
+                                            "\"");
+            if (*sides < 3 || *sides > maxSides) r.fail("sides", sidesRange);
+            in.sidesMin = in.sidesMax = int(*sides);
+        }
+        if (in.polygon == PolygonKind::Regular) {
+            r.forbid("aspect", "only for polygon = \"rectangle\" or \"random\"");
+        } else {
+            in.aspect = r.number("aspect").value_or(in.polygon == PolygonKind::Random ? 1.5 : 1.0);
+            if (in.polygon == PolygonKind::Rectangle && !(in.aspect > 0)) r.fail("aspect", "must be > 0");
+            if (in.polygon == PolygonKind::Random && !(in.aspect >= 1)) r.fail("aspect", "must be >= 1");
+        }
+        in.orientation = 0.0;
+        if (const toml::node* n = r.table().get("orientation")) {
+            if (const auto* str = n->as_string()) {
+                if (str->get() != "random") r.fail("orientation", "must be \"random\" or a number (radians)");
+                in.orientation.reset();
+            } else if (n->is_number()) {
+                in.orientation = r.number("orientation");
+            } else {
+                r.fail("orientation", "expected a number (radians) or \"random\"");
+            }
+        }
     }
 
     void readRadius(const TableReader& r, InsertDef& in) const {
@@ -588,6 +671,7 @@ private:
     int dim_ = 3;
     DomainDef domain_;
     const std::vector<MaterialDef>* materials_ = nullptr;
+    bool needDiskLaw_ = false;
 };
 
 }  // namespace

@@ -4,10 +4,14 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "polygon/forces.hpp"
+
 namespace haet {
 
 template <int D>
 TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s) {
+    if constexpr (D == 2)
+        if (w_.particles.hasPolygons()) poly_ = std::make_unique<polygon::PolygonScratch>();
     if (s.integrator == IntegratorKind::Gear5)
         integ_ = std::make_unique<Gear5<D>>();
     else
@@ -29,6 +33,14 @@ void TdmEngine<D>::computeForces() {
     auto run = [&](auto normal, auto tangential) {
         using N = decltype(normal);
         using T = decltype(tangential);
+        if constexpr (D == 2) {
+            if (poly_) {  // polygons present: their loop (polygon/forces.hpp) also serves the disks among them
+                stats_ = polygon::computePolygonForces<N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs,
+                                                             w_.domain, w_.time, s_.dt, motion_.v.data(),
+                                                             motion_.w.data(), scratch_, *poly_);
+                return;
+            }
+        }
         stats_ = haet::computeForces<D, N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain, w_.time,
                                               s_.dt, motion_.v.data(), motion_.w.data(), scratch_);
     };
@@ -205,9 +217,14 @@ double TdmEngine<D>::contactEnergy() const {
         return 0.4 * c.hertzK * std::sqrt(reff) * std::pow(delta, 2.5);
     };
     double e = 0;
+    if (poly_) {  // polygon contacts: the estimates of the last force evaluation (polygon/contact.hpp)
+        for (double x : poly_->pairEnergy) e += x;
+        for (double x : poly_->wallEnergy) e += x;
+    }
     for (std::size_t i = 0; i < p.tdmCount(); ++i) {
         for (std::uint32_t k = pairs_.first[i]; k < pairs_.first[i + 1]; ++k) {
             const std::uint32_t j = pairs_.partner[k];
+            if (poly_ && (p.isPolygon(i) || p.isPolygon(j))) continue;
             const Vec<D> d = p.x[i] - p.x[j] + pairs_.shiftVec[pairs_.shift[k]];
             const double rs = p.radius[i] + p.radius[j];
             const double delta = rs - norm(d);
@@ -216,6 +233,7 @@ double TdmEngine<D>::contactEnergy() const {
             const double meff = fi ? p.mass[j] : (fj ? p.mass[i] : p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]));
             e += elastic(cs.pair(p.material[i], p.material[j]), delta, meff, p.radius[i] * p.radius[j] / rs);
         }
+        if (poly_ && p.isPolygon(i)) continue;
         for (const Wall<D>& wall : w_.walls) {
             const double delta = p.radius[i] - wall.distance(p.x[i], w_.time);
             if (delta > 0) e += elastic(cs.pair(p.material[i], wall.material), delta, p.mass[i], p.radius[i]);

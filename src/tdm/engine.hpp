@@ -13,6 +13,10 @@
 
 namespace haet {
 
+namespace polygon {
+struct PolygonScratch;
+}
+
 struct TdmSettings {
     IntegratorKind integrator = IntegratorKind::Verlet;
     double dt = 0;             ///< [s]
@@ -69,6 +73,7 @@ private:
     std::vector<Vec<D>> wallHistory_;
     std::vector<Vec<D>> xAtBuild_;
     ForceStats stats_;
+    std::unique_ptr<polygon::PolygonScratch> poly_;  ///< 2D scenes with polygons: their force loop's arrays
     std::uint64_t steps_ = 0, rebuilds_ = 0, lastSort_ = 0;
 };
 

@@ -19,6 +19,10 @@ std::vector<MaterialStats> materialStats(const Particles<D>& p, int nMaterials) 
         s.minRadius = s.count ? std::min(s.minRadius, p.radius[i]) : p.radius[i];
         s.minMass = s.count ? std::min(s.minMass, p.mass[i]) : p.mass[i];
         ++s.count;
+        if (p.isPolygon(i)) {
+            s.minPolygonMass = s.polygons ? std::min(s.minPolygonMass, p.mass[i]) : p.mass[i];
+            ++s.polygons;
+        }
     }
     for (auto& s : st)
         if (s.count) {
@@ -60,12 +64,29 @@ template <int D>
 TdmSettings tdmSettings(const Scenario& sc, const World<D>& w, std::string* dtNote) {
     TdmSettings s;
     s.integrator = sc.tdm.integrator;
+    const Particles<D>& p = w.particles;
+    std::size_t polygons = 0;
+    if constexpr (D == 2)
+        for (std::size_t i = 0; i < p.size(); ++i) polygons += p.isPolygon(i);
+    // Polygons: Gear's predictor-corrector unless the scenario names an integrator (PHYSICS.md F.3).
+    if (polygons > 0 && !sc.tdm.integratorGiven) s.integrator = IntegratorKind::Gear5;
     s.maxOverlap = sc.tdm.maxOverlap;
     s.sortEvery = sc.tdm.sortEvery;
     std::ostringstream note;
     if (sc.tdm.dt) {
         s.dt = *sc.tdm.dt;
         note << "given; t_c/dt = " << w.contact.contactTime / s.dt;
+    } else if (polygons > 0) {
+        // The polygon rule; disks among them also keep their t_c / steps_per_contact.
+        s.dt = w.contact.polygonStep;
+        note << "auto: polygons, (pi/10) sqrt(m_min/Y)";
+        if (w.contact.polygonStepFactor < 1)
+            note << " x " << w.contact.polygonStepFactor << " (0.2/gamma: Gear's limit for strong damping)";
+        if (polygons < p.size() && w.contact.diskContactTime / sc.tdm.stepsPerContact < s.dt) {
+            s.dt = w.contact.diskContactTime / sc.tdm.stepsPerContact;
+            note.str("");
+            note << "auto: t_c / " << sc.tdm.stepsPerContact << " of the disks (shorter than the polygons' rule)";
+        }
     } else {
         s.dt = w.contact.contactTime / sc.tdm.stepsPerContact;
         note << "auto: t_c / " << sc.tdm.stepsPerContact << " (" << w.contact.contactTimeNote << ")";

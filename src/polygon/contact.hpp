@@ -1,0 +1,138 @@
+#pragma once
+// The overlap-area contact law of 2D polygons (Matuttis & Chen; PHYSICS.md G.3), as a pure function of the overlap
+// geometry and the two bodies' motion. One law serves polygon-polygon, polygon-disk and polygon-wall contacts.
+//
+//   normal n        perpendicular to the chord c (c: body i's outline inside body j, geometry.hpp), from j to i
+//   force point     the overlap centroid C;  r_i = C - x_i, r_j = C - x_j
+//   length          l = 4 |r_i| |r_j| / (|r_i| + |r_j|)   (a wall: l = 4 |r_i|); floored at lMin
+//   elastic         F_el = Y A / l
+//   damping         F_d = gamma sqrt(m_eff Y) (dA/dt) / l; if F_d > 2 F_el then F_d = F_el (no kick at first touch)
+//                   F_n = F_el + F_d, clipped at 0 unless attraction is allowed
+//   dA/dt           exact for rigid motion: -|c| (g . n) - (omega_i - omega_j) s, g the relative velocity at C
+//   tangential      Cundall-Strack spring xi along t = perp(n), incremented by the mean relative velocity over the
+//                   step; F_t = -k_t xi - gamma_t sqrt(k_t m_t) g_t, |F_t| <= mu F_n (slip shortens the spring),
+//                   1/m_t = 1/m_i + 1/m_j + |r_i|^2/I_i + |r_j|^2/I_j
+//   torques         tau_i = (r_i x F)_z, tau_j = -(r_j x F)_z, F the force on i
+// Since tau_i + tau_j + (x_i - x_j) x F = 0, pair forces conserve linear and angular momentum exactly.
+#include <cmath>
+
+#include "polygon/geometry.hpp"
+
+namespace haet::polygon {
+
+/// Coefficients of the polygon law for one material pair (built once, contact/setup.cpp).
+struct PolygonCoeffs {
+    double young = 0;   ///< Y [N/m] (2D: stiffness per length), F_el = Y A / l
+    double gamma = 0;   ///< normal damping, dimensionless (PHYSICS.md G.3)
+    double kt = 0;      ///< tangential spring stiffness [N/m]; 0 = no tangential force
+    double gammaT = 0;  ///< tangential damping: F = -gammaT sqrt(k_t m_t) g_t [-]
+    double mu = 0;      ///< Coulomb friction [-]
+};
+
+/// Motion of one body in the pair's frame (any common origin).
+struct BodyState {
+    V2 x{};                 ///< centre of mass [m]
+    V2 v{};                 ///< velocity [m/s] (the predicted one, seen by the damping)
+    double w = 0;           ///< angular velocity [rad/s]
+    V2 vStep{};             ///< mean velocity over the last step [m/s] (drives the spring)
+    double wStep = 0;       ///< mean angular velocity over the last step [rad/s]
+    double invMass = 0;     ///< [1/kg]; 0 for a frozen body or a wall
+    double invInertia = 0;  ///< [1/(kg m^2)]; 0 for a frozen body or a wall
+};
+
+struct ContactForce {
+    V2 f{};              ///< force on i [N] (on j: -f)
+    double torqueI = 0;  ///< [N m]
+    double torqueJ = 0;  ///< [N m]
+    double fn = 0;       ///< normal force [N]
+    V2 normal{};         ///< unit normal, from j to i
+    double length = 0;   ///< characteristic length l [m]
+};
+
+/// Rate of change of the overlap area [m^2/s] under the bodies' rigid motion, exact (geometry.hpp):
+/// dA/dt = (v_i - v_j) . (c_y, -c_x) - omega_i (s + r_i . c) + omega_j (s + r_j . c), r = C - x.
+inline double areaRate(const Overlap& o, const BodyState& bi, const BodyState& bj) {
+    const V2 grad{{o.chord[1], -o.chord[0]}};
+    return dot(bi.v - bj.v, grad) - bi.w * (o.spin + dot(o.centroid - bi.x, o.chord)) +
+           bj.w * (o.spin + dot(o.centroid - bj.x, o.chord));
+}
+
+/// Evaluates the law for an overlap `o` of body i (its outline gave o.chord and o.spin) with body j.
+/// `wallNormal` (unit, pointing to i) replaces the chord's normal and makes j a wall: then l = 4 |r_i|.
+/// xi: the tangential spring [m], stored as a vector along t so that it changes sign with the pair's order.
+/// When the chord vanishes (one body inside the other) the normal falls back to the line of centres, and to +x
+/// when the centres coincide.
+inline ContactForce polygonContact(const PolygonCoeffs& c, const Overlap& o, const BodyState& bi,
+                                   const BodyState& bj, const V2* wallNormal, double lMin, bool attraction,
+                                   bool friction, double dt, V2& xi) {
+    ContactForce out;
+    const double clen = norm(o.chord);
+    V2 n;
+    if (wallNormal) {
+        n = *wallNormal;
+    } else if (clen > 1e-12 * std::sqrt(o.area)) {
+        n = perp(o.chord) / clen;
+    } else {
+        const V2 d = bi.x - bj.x;
+        const double dl = norm(d);
+        n = dl > 0 ? d / dl : V2{{1.0, 0.0}};
+    }
+    const V2 ri = o.centroid - bi.x, rj = o.centroid - bj.x;
+    const double li = norm(ri);
+    double l;
+    if (wallNormal) {
+        l = 4 * li;
+    } else {
+        const double lj = norm(rj);
+        l = li + lj > 0 ? 4 * li * lj / (li + lj) : 0.0;
+    }
+    l = std::max(l, lMin);
+    const double fel = c.young * o.area / l;
+
+    // Relative velocity of the force point, and the rate of change of the overlap area.
+    const V2 g = bi.v + perp(ri) * bi.w - bj.v - perp(rj) * bj.w;
+    const double dAdt = areaRate(o, bi, bj);
+    const double invM = bi.invMass + bj.invMass;
+    const double meff = invM > 0 ? 1.0 / invM : 0.0;
+    double fd = c.gamma * std::sqrt(meff * c.young) * dAdt / l;
+    if (fd > 2 * fel) fd = fel;
+    double fn = fel + fd;
+    if (!attraction && fn < 0) fn = 0;
+    V2 f = n * fn;
+
+    if (friction && c.kt > 0) {
+        const V2 t = perp(n);
+        // The contact line turns with the pair: keep the spring's length, take its sign along the new tangent.
+        const double len = norm(xi);
+        double s = dot(xi, t) >= 0 ? len : -len;
+        const V2 gs = bi.vStep + perp(ri) * bi.wStep - bj.vStep - perp(rj) * bj.wStep;
+        s += dot(gs, t) * dt;
+        const double gt = dot(g, t);
+        const double invMt = invM + norm2(ri) * bi.invInertia + norm2(rj) * bj.invInertia;
+        const double ct = invMt > 0 ? c.gammaT * std::sqrt(c.kt / invMt) : 0.0;
+        double ft = -c.kt * s - ct * gt;
+        const double fmax = c.mu * fn;
+        if (std::abs(ft) > fmax) {
+            ft = ft > 0 ? fmax : -fmax;
+            s = -(ft + ct * gt) / c.kt;
+        }
+        xi = t * s;
+        f += t * ft;
+    }
+    out.f = f;
+    out.torqueI = cross2(ri, f);
+    out.torqueJ = -cross2(rj, f);
+    out.fn = fn;
+    out.normal = n;
+    out.length = l;
+    return out;
+}
+
+/// Elastic energy of a contact, estimated as Y A^2 / (2 l |c|): exact for a flat contact (A = |c| depth), 3/4 of
+/// the work done for a vertex contact (A ~ depth^2). The law has no potential in general (PHYSICS.md G.3).
+inline double polygonContactEnergy(const PolygonCoeffs& c, const Overlap& o, double l) {
+    const double clen = norm(o.chord);
+    return clen > 0 && l > 0 ? c.young * o.area * o.area / (2 * l * clen) : 0.0;
+}
+
+}  // namespace haet::polygon

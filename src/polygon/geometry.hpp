@@ -1,0 +1,388 @@
+#pragma once
+// Geometry of 2D convex polygons (PHYSICS.md G.1, G.2): area, centroid and moment of inertia from the vertices,
+// shape generators, the separating-axis test, the overlap of two convex polygons by Sutherland-Hodgman clipping,
+// the overlap of a circle and a convex polygon, and the overlap of a polygon with a half-plane (a wall).
+//
+// Every overlap routine also returns the two quantities the force law needs besides area and centroid
+// (PHYSICS.md G.3):
+//  - the chord c: the sum of the edge vectors of the overlap's boundary that lie on the first body's outline,
+//    counter-clockwise. With two outline intersection points S1, S2 it is S2 - S1, and the contact normal is
+//    perpendicular to it. It is also the gradient of the overlap area: translating the first body by t changes
+//    the area by (c_y, -c_x) . t. So the normal from c stays defined when the outlines cross more than twice
+//    (deep overlaps): it is the direction in which the overlap shrinks fastest.
+//  - the spin moment s = sum over the same edges of (|b - C|^2 - |a - C|^2)/2, with C the overlap centroid:
+//    spinning the first body about C changes the area by -omega s, which makes dA/dt exact for rigid motion.
+// Edges that lie on both outlines (parallel, touching edges) count once, for whichever body the clipping
+// assigned them to; their contributions cancel in c, so the normal does not depend on that choice.
+//
+// Degenerate cases never produce NaN: a segment is only intersected with a line when its end points lie
+// strictly on different sides; fewer than three surviving vertices means no overlap (area 0); touching outlines
+// (vertex on vertex, edge on edge) give zero area.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/rng.hpp"
+#include "core/vec.hpp"
+
+namespace haet::polygon {
+
+using V2 = Vec<2>;
+
+/// Most vertices of one particle's polygon (the "3 to ~20").
+inline constexpr int kMaxVertices = 20;
+/// Capacity of an overlap polygon: clipping a convex n-gon by a convex m-gon leaves at most n + m vertices.
+inline constexpr int kMaxClip = 2 * kMaxVertices + 4;
+
+inline double cross2(const V2& a, const V2& b) { return a[0] * b[1] - a[1] * b[0]; }
+/// a rotated by +90 degrees.
+inline V2 perp(const V2& a) { return V2{{-a[1], a[0]}}; }
+/// a rotated by angle phi [rad], given its cosine and sine.
+inline V2 rotate(const V2& a, double c, double s) { return V2{{c * a[0] - s * a[1], s * a[0] + c * a[1]}}; }
+
+/// Stack room for N vertices left uninitialised: Vec zero-fills itself, and clearing the buffers of every pair
+/// cost as much as the clipping (measured). The code writes every vertex before reading it.
+template <int N>
+struct VertexBuffer {
+    VertexBuffer() {}
+    union {
+        V2 v[N];
+    };
+    V2& operator[](int k) { return v[k]; }
+    const V2& operator[](int k) const { return v[k]; }
+    V2* data() { return v; }
+};
+
+/// Area, centroid and moment of inertia of a polygon of unit areal density.
+struct Moments {
+    double area = 0;            ///< signed: > 0 for counter-clockwise vertices [m^2]
+    V2 centroid{};              ///< [m]
+    double inertiaPerMass = 0;  ///< I about the centroid divided by the mass [m^2]
+};
+
+/// PHYSICS.md G.1. Computed relative to the first vertex, which keeps the round-off relative to the polygon's
+/// size even far from the origin.
+inline Moments polygonMoments(const V2* v, int n) {
+    const V2 o = v[0];
+    double a2 = 0, mx = 0, my = 0, io = 0;
+    for (int k = 0; k < n; ++k) {
+        const V2 p = v[k] - o, q = v[(k + 1) % n] - o;
+        const double cr = cross2(p, q);
+        a2 += cr;
+        mx += (p[0] + q[0]) * cr;
+        my += (p[1] + q[1]) * cr;
+        io += cr * (p[0] * p[0] + p[0] * q[0] + q[0] * q[0] + p[1] * p[1] + p[1] * q[1] + q[1] * q[1]);
+    }
+    Moments m;
+    m.area = 0.5 * a2;
+    if (m.area == 0) {
+        m.centroid = o;
+        return m;
+    }
+    const V2 c{{mx / (3 * a2), my / (3 * a2)}};
+    m.centroid = o + c;
+    m.inertiaPerMass = (io / 12.0) / m.area - norm2(c);  // parallel-axis theorem: I_c = I_o - m |c|^2
+    return m;
+}
+
+/// Largest distance of a vertex from `c` [m].
+inline double circumradius(const V2* v, int n, const V2& c) {
+    double r2 = 0;
+    for (int k = 0; k < n; ++k) r2 = std::max(r2, norm2(v[k] - c));
+    return std::sqrt(r2);
+}
+
+/// True when the vertices are in counter-clockwise order and every corner turns left (strictly convex up to a
+/// relative tolerance), with no repeated vertex.
+inline bool isConvexCcw(const V2* v, int n) {
+    if (n < 3) return false;
+    double scale = 0;
+    for (int k = 0; k < n; ++k) scale = std::max(scale, norm2(v[k] - v[0]));
+    if (!(scale > 0)) return false;
+    for (int k = 0; k < n; ++k) {
+        const V2 e0 = v[(k + 1) % n] - v[k], e1 = v[(k + 2) % n] - v[(k + 1) % n];
+        if (!(cross2(e0, e1) > 1e-12 * scale)) return false;
+    }
+    // Turning left at every corner can still wind twice around; the total angle must be one turn.
+    double turn = 0;
+    for (int k = 0; k < n; ++k) {
+        const V2 e0 = v[(k + 1) % n] - v[k], e1 = v[(k + 2) % n] - v[(k + 1) % n];
+        turn += std::atan2(cross2(e0, e1), dot(e0, e1));
+    }
+    return std::abs(turn - 2 * 3.14159265358979323846) < 1e-6;
+}
+
+// ---- shapes, in the body frame (centroid at the origin, counter-clockwise) ----
+
+/// Moves the vertices so that their centroid is the origin.
+inline void centre(std::vector<V2>& v) {
+    const V2 c = polygonMoments(v.data(), int(v.size())).centroid;
+    for (V2& p : v) p -= c;
+}
+
+/// Regular n-gon of circumradius R [m], first vertex at angle `orientation` [rad].
+inline std::vector<V2> regularPolygon(int n, double R, double orientation) {
+    std::vector<V2> v(n);
+    const double twoPi = 2 * 3.14159265358979323846;
+    for (int k = 0; k < n; ++k) {
+        const double a = orientation + twoPi * k / n;
+        v[k] = V2{{R * std::cos(a), R * std::sin(a)}};
+    }
+    return v;
+}
+
+/// Rectangle whose half-diagonal is R [m] and whose sides have the ratio `aspect` (length along the body x axis
+/// over length along y), turned by `orientation` [rad].
+inline std::vector<V2> rectangle(double aspect, double R, double orientation) {
+    const double h = 1 / std::sqrt(1 + aspect * aspect);
+    const double hx = R * aspect * h, hy = R * h;
+    const double c = std::cos(orientation), s = std::sin(orientation);
+    std::vector<V2> v = {V2{{hx, -hy}}, V2{{hx, hy}}, V2{{-hx, hy}}, V2{{-hx, -hy}}};
+    for (V2& p : v) p = rotate(p, c, s);
+    return v;
+}
+
+/// A random convex polygon with n vertices and circumradius R about its centroid [m]: vertices on an ellipse of
+/// axis ratio uniform in [1, maxAspect], at angles 2 pi (k + u_k)/n with u_k uniform in [-0.35, 0.35] (so no two
+/// vertices come closer than 0.3 of the regular spacing), turned by `orientation` [rad]. Points taken in order
+/// along a convex curve always form a convex polygon.
+inline std::vector<V2> randomConvexPolygon(Rng& rng, int n, double R, double maxAspect, double orientation) {
+    const double twoPi = 2 * 3.14159265358979323846;
+    const double stretch = rng.uniform(1.0, maxAspect);
+    const double c = std::cos(orientation), s = std::sin(orientation);
+    std::vector<V2> v(n);
+    for (int k = 0; k < n; ++k) {
+        const double a = twoPi * (k + rng.uniform(-0.35, 0.35)) / n;
+        v[k] = rotate(V2{{stretch * std::cos(a), std::sin(a)}}, c, s);
+    }
+    centre(v);
+    const double r = circumradius(v.data(), n, V2::zero());
+    for (V2& p : v) p *= R / r;
+    return v;
+}
+
+// ---- separating axes ----
+
+/// True when some edge of P or Q separates the two convex counter-clockwise polygons (touching counts as
+/// separated: the overlap area is zero). PHYSICS.md G.4.
+inline bool separated(const V2* P, int np, const V2* Q, int nq) {
+    auto byEdgesOf = [](const V2* A, int na, const V2* B, int nb) {
+        for (int k = 0; k < na; ++k) {
+            const V2 a = A[k], e = A[k + 1 == na ? 0 : k + 1] - a;
+            bool allOutside = true;
+            for (int m = 0; m < nb && allOutside; ++m) allOutside = cross2(e, B[m] - a) <= 0;
+            if (allOutside) return true;
+        }
+        return false;
+    };
+    return byEdgesOf(P, np, Q, nq) || byEdgesOf(Q, nq, P, np);
+}
+
+/// True when the projections on the direction `u` (any length) of P shifted by a vector whose projection is `shift`
+/// and of Q do not overlap (touching counts as apart). The line of centres is the axis that separates most
+/// non-touching pairs of a cell list, at n + m dot products.
+inline bool separatedAlong(const V2& u, double shift, const V2* P, int np, const V2* Q, int nq) {
+    double minP = dot(P[0], u), maxQ = dot(Q[0], u);
+    for (int k = 1; k < np; ++k) minP = std::min(minP, dot(P[k], u));
+    for (int k = 1; k < nq; ++k) maxQ = std::max(maxQ, dot(Q[k], u));
+    return shift + minP >= maxQ;
+}
+
+// ---- overlaps ----
+
+/// The overlap of two bodies as the force law needs it. Coordinates are those of the inputs.
+struct Overlap {
+    double area = 0;  ///< [m^2]; 0 when the bodies do not overlap (then the other members are unset)
+    V2 centroid{};    ///< C [m]
+    V2 chord{};       ///< c: sum of the first body's outline pieces inside the second [m] (see the file comment)
+    double spin = 0;  ///< s: sum over those pieces of (|b - C|^2 - |a - C|^2)/2 [m^2]
+    int vertices = 0; ///< vertices of the overlap polygon (0 for a circle)
+};
+
+/// Overlap of the convex counter-clockwise polygons P (the first body) and Q by Sutherland-Hodgman clipping of P
+/// against every edge of Q. Vertices beyond kMaxVertices per polygon are not supported. If `out` is given it
+/// receives the overlap polygon (capacity kMaxClip). `pCentre`, `pRadius`: a circle holding P, if known; an edge of Q
+/// whose inner half-plane holds that whole circle cannot cut P and is skipped (one test instead of one per vertex).
+inline Overlap clipOverlap(const V2* P, int np, const V2* Q, int nq, V2* out = nullptr, const V2* pCentre = nullptr,
+                           double pRadius = 0) {
+    // Each vertex carries the owner of the edge that leaves it: 0 = P's outline, 1 = Q's.
+    VertexBuffer<kMaxClip> bufA, bufB;
+    std::uint8_t tagA[kMaxClip], tagB[kMaxClip];
+    V2* cur = bufA.data();
+    V2* nxt = bufB.data();
+    std::uint8_t* ct = tagA;
+    std::uint8_t* nt = tagB;
+    int n = np;
+    for (int k = 0; k < np; ++k) {
+        cur[k] = P[k];
+        ct[k] = 0;
+    }
+    for (int e = 0; e < nq && n >= 3; ++e) {
+        const V2 q0 = Q[e], d = Q[e + 1 == nq ? 0 : e + 1] - q0;
+        if (pCentre) {
+            const double sc = cross2(d, *pCentre - q0);  // |d| x the centre's distance inside the edge's line
+            if (sc > 0 && sc * sc >= pRadius * pRadius * norm2(d)) continue;
+        }
+        // Sides first: an edge that leaves every vertex inside changes nothing (the common case), one that leaves
+        // none inside ends the overlap.
+        double side[kMaxClip];
+        int inside = 0;
+        for (int k = 0; k < n; ++k) {
+            side[k] = cross2(d, cur[k] - q0);
+            inside += side[k] >= 0;
+        }
+        if (inside == n) continue;
+        if (inside == 0) return Overlap{};
+        int m = 0;
+        V2 a = cur[n - 1];
+        double sa = side[n - 1];
+        std::uint8_t ta = ct[n - 1];
+        for (int k = 0; k < n && m < kMaxClip - 1; ++k) {
+            const V2 b = cur[k];
+            const double sb = side[k];
+            const bool ain = sa >= 0, bin = sb >= 0;
+            if (ain != bin) {
+                // Strictly different sides: sa - sb is nonzero.
+                const double t = sa / (sa - sb);
+                nxt[m] = a + (b - a) * t;
+                nt[m] = bin ? ta : 1;  // entering: the rest of a->b; leaving: along Q's edge e
+                ++m;
+            }
+            if (bin) {
+                nxt[m] = b;
+                nt[m] = ct[k];
+                ++m;
+            }
+            a = b;
+            sa = sb;
+            ta = ct[k];
+        }
+        std::swap(cur, nxt);
+        std::swap(ct, nt);
+        n = m;
+    }
+    Overlap o;
+    if (n < 3) return o;
+    // Area, centroid, chord and spin in one pass, relative to the first vertex (spin about it, then moved to C:
+    // s_C = s_0 - (C - v0) . c).
+    const V2 o0 = cur[0];
+    double a2 = 0, mx = 0, my = 0, spin0 = 0;
+    V2 chord{};
+    for (int k = 0; k < n; ++k) {
+        const V2 p = cur[k] - o0, q = cur[k + 1 == n ? 0 : k + 1] - o0;
+        const double cr = cross2(p, q);
+        a2 += cr;
+        mx += (p[0] + q[0]) * cr;
+        my += (p[1] + q[1]) * cr;
+        if (ct[k] == 0) {
+            chord += q - p;
+            spin0 += 0.5 * (norm2(q) - norm2(p));
+        }
+    }
+    if (!(a2 > 0)) return o;
+    const V2 c{{mx / (3 * a2), my / (3 * a2)}};
+    o.area = 0.5 * a2;
+    o.centroid = o0 + c;
+    o.chord = chord;
+    o.spin = spin0 - dot(c, chord);
+    o.vertices = n;
+    if (out)
+        for (int k = 0; k < n; ++k) out[k] = cur[k];
+    return o;
+}
+
+/// Overlap of the disk of radius R centred at the origin with the convex counter-clockwise polygon Q (the first
+/// body is the polygon: chord and spin are those of Q's outline inside the circle). Exact: the overlap is cut
+/// into triangles (centre, edge piece inside the circle) and circular sectors (edge pieces outside).
+inline Overlap circlePolygonOverlap(double R, const V2* Q, int nq) {
+    const double R2 = R * R;
+    double area2 = 0;  // twice the area
+    V2 mom2{};         // twice the first moment
+    V2 chord{};
+    double spinO = 0;  // spin about the circle centre
+    bool boundaryInside = false;
+    bool centreInside = true;
+    auto sector = [&](const V2& p, const V2& q) {
+        const double th = std::atan2(cross2(p, q), dot(p, q));
+        area2 += R2 * th;
+        const V2 u = p / norm(p), w = q / norm(q);
+        mom2 += V2{{w[1] - u[1], u[0] - w[0]}} * (2 * R2 * R / 3);
+    };
+    for (int k = 0; k < nq; ++k) {
+        const V2 a = Q[k], b = Q[k + 1 == nq ? 0 : k + 1], d = b - a;
+        if (cross2(d, -a) < 0) centreInside = false;
+        const double dd = norm2(d), ad = dot(a, d);
+        const double disc = ad * ad - dd * (norm2(a) - R2);
+        double t0 = 1, t1 = 0;
+        if (disc > 0 && dd > 0) {
+            const double sq = std::sqrt(disc);
+            t0 = std::max(0.0, (-ad - sq) / dd);
+            t1 = std::min(1.0, (-ad + sq) / dd);
+        }
+        if (t0 < t1) {
+            const V2 p0 = a + d * t0, p1 = a + d * t1;
+            if (t0 > 0) sector(a, p0);
+            const double cr = cross2(p0, p1);
+            area2 += cr;
+            mom2 += (p0 + p1) * (cr / 3.0);
+            chord += p1 - p0;
+            spinO += 0.5 * (norm2(p1) - norm2(p0));
+            boundaryInside = true;
+            if (t1 < 1) sector(p1, b);
+        } else {
+            sector(a, b);
+        }
+    }
+    Overlap o;
+    if (!boundaryInside && !centreInside) return o;  // no outline inside the circle, centre outside: apart
+    if (!(area2 > 0)) return o;
+    o.area = 0.5 * area2;
+    o.centroid = mom2 / area2;
+    o.chord = chord;
+    o.spin = spinO - dot(o.centroid, chord);  // about C: sum (|b|^2 - |a|^2)/2 - C . sum (b - a)
+    return o;
+}
+
+/// Overlap of the convex counter-clockwise polygon P with the half-plane { y : n . (y - p0) <= 0 } (the outside of
+/// a wall whose unit normal n points into the domain). The chord is P's outline inside the half-plane.
+inline Overlap halfPlaneOverlap(const V2* P, int np, const V2& p0, const V2& n) {
+    VertexBuffer<kMaxVertices + 2> poly;
+    std::uint8_t tag[kMaxVertices + 2];
+    int m = 0;
+    V2 a = P[np - 1];
+    double sa = -dot(n, a - p0);
+    for (int k = 0; k < np; ++k) {
+        const V2 b = P[k];
+        const double sb = -dot(n, b - p0);
+        const bool ain = sa >= 0, bin = sb >= 0;
+        if (ain != bin) {
+            const double t = sa / (sa - sb);
+            poly[m] = a + (b - a) * t;
+            tag[m++] = bin ? 0 : 1;
+        }
+        if (bin) {
+            poly[m] = b;
+            tag[m++] = 0;
+        }
+        a = b;
+        sa = sb;
+    }
+    Overlap o;
+    if (m < 3) return o;
+    const Moments mo = polygonMoments(poly.data(), m);
+    if (!(mo.area > 0)) return o;
+    o.area = mo.area;
+    o.centroid = mo.centroid;
+    o.vertices = m;
+    for (int k = 0; k < m; ++k) {
+        if (tag[k] != 0) continue;
+        const V2 u = poly[k] - o.centroid, w = poly[k + 1 == m ? 0 : k + 1] - o.centroid;
+        o.chord += w - u;
+        o.spin += 0.5 * (norm2(w) - norm2(u));
+    }
+    return o;
+}
+
+}  // namespace haet::polygon
