@@ -126,6 +126,7 @@ public:
     void describe(JsonObject& j) const override {
         j.add("events", eng_.events());
         j.add("collisions", eng_.collisions());
+        j.add("tc_elastic", eng_.stats().tcElastic);
         j.add("tc_time", eng_.tcTime());
     }
 
