@@ -218,7 +218,9 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
             return std::make_unique<TdmDriver<D>>(world, ts, note);
         }
-        case Method::Edm: return std::make_unique<EdmDriver<D>>(world, edmSettings(sc));
+        case Method::Edm:
+            world.particles.dropTdmState();  // forces, torques and angles: nothing reads them in this run
+            return std::make_unique<EdmDriver<D>>(world, edmSettings(sc));
         case Method::Haet: {
             std::string note;
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
@@ -240,11 +242,12 @@ public:
         std::vector<double> xyz(3 * n, 0.0), vel(3 * n, 0.0), spin(3 * n, 0.0), force(3 * n, 0.0), rad(n);
         std::vector<std::int64_t> ids(n);
         std::vector<std::int32_t> mat(n);
+        const bool forces = p.hasTdmState();  // a pure event-driven run has none: written as zero
         for (std::size_t i = 0; i < n; ++i) {
             for (int k = 0; k < D; ++k) {
                 xyz[3 * i + k] = p.x[i][k];
                 vel[3 * i + k] = p.v[i][k];
-                force[3 * i + k] = p.f[i][k];
+                if (forces) force[3 * i + k] = p.f[i][k];
             }
             if constexpr (D == 2) spin[3 * i + 2] = p.w[i][0];
             else for (int k = 0; k < 3; ++k) spin[3 * i + k] = p.w[i][k];

@@ -8,6 +8,8 @@ namespace haet {
 
 template <int D>
 TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s) {
+    if (!w_.particles.hasTdmState())
+        throw std::invalid_argument("time-driven engine: the particle store has dropped forces and angles");
     if (s.integrator == IntegratorKind::Gear5)
         integ_ = std::make_unique<Gear5<D>>();
     else
