@@ -61,7 +61,12 @@ class Driver {
 public:
     virtual ~Driver() = default;
     virtual const char* method() const = 0;
+    /// Runs the engine to time t; world.time = t. An engine that moves its particles lazily (the EDM) may leave
+    /// the World's particle state behind: synchronise() brings it to world.time.
     virtual void advanceTo(double t) = 0;
+    /// The run loop calls this before it reads the particles (outputs, the end of the run), not after every
+    /// progress chunk: an EDM synchronisation costs O(N), and 500 chunks of a short run cost more than its events.
+    virtual void synchronise() {}
     /// Time resolution of the engine: the loop treats times closer than this as equal [s].
     virtual double timeTolerance() const = 0;
     virtual std::uint64_t steps() const = 0;          ///< time steps taken (0 for a pure event-driven run)
@@ -106,9 +111,13 @@ private:
 template <int D>
 class EdmDriver final : public Driver<D> {
 public:
-    EdmDriver(World<D>& w, const EdmSettings& s) : eng_(w, s) {}
+    EdmDriver(World<D>& w, const EdmSettings& s) : w_(w), eng_(w, s) {}
     const char* method() const override { return "edm"; }
-    void advanceTo(double t) override { eng_.advanceTo(t); }
+    void advanceTo(double t) override {
+        eng_.advanceEvents(t);
+        w_.time = t;
+    }
+    void synchronise() override { eng_.synchronise(w_.time); }
     double timeTolerance() const override { return 1e-12; }
     std::uint64_t steps() const override { return 0; }
     std::size_t contacts() const override { return 0; }
@@ -131,6 +140,7 @@ public:
     }
 
 private:
+    World<D>& w_;
     EdmEngine<D> eng_;
 };
 
@@ -482,15 +492,20 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     try {
         for (;;) {
             if (world.time + eps >= nextSeries) {
+                eng->synchronise();
                 writeRow();
                 nextSeries += seriesPeriod;
             }
             if (snapPeriod > 0 && world.time + eps >= nextSnap) {
+                eng->synchronise();
                 snaps.write(world, world.time, eng->hybrid());
                 series.flush();
                 nextSnap += snapPeriod;
             }
-            if (world.time + eps >= sc.duration) break;
+            if (world.time + eps >= sc.duration) {
+                eng->synchronise();
+                break;
+            }
             double target = std::min(sc.duration, nextSeries);
             if (snapPeriod > 0) target = std::min(target, nextSnap);
             while (world.time + eps < target) {
