@@ -34,6 +34,7 @@ void gas(benchmark::State& state) {
     g.phi = phi;
     g.seed = 5;
     haet::World<D> w = haet::testing::makeGas<D>(g, haet::testing::edmContact(1.0));
+    w.particles.dropTdmState();  // as a method = "edm" run does
     haet::EdmSettings s;
     s.tcModel = false;
     haet::EdmEngine<D> eng(w, s);

@@ -6,8 +6,9 @@
 # 1. bench/compare_lammps.sh BUILD_DIR 3d   HAET against LAMMPS, 3D chute (32 000 spheres)
 # 2. bench/compare_lammps.sh BUILD_DIR 2d   the same in 2D (8 000 disks)
 # 3. bench/haet_compare.sh BUILD_DIR        the hybrid against pure TDM and EDM (demo), dilute-fraction sweep
-# 4. BUILD_DIR/haet_bench                   Google Benchmark micro-benchmarks, when built
-# 5. BUILD_DIR/haet_bench PolygonSettle2D   10 000 hexagons vs 10 000 disks settling, 1 and 2 threads, side by
+# 4. bench/dilute_compare.sh BUILD_DIR      EDM against TDM on a dilute granular gas, 3D and 2D
+# 5. BUILD_DIR/haet_bench                   Google Benchmark micro-benchmarks, when built
+# 6. BUILD_DIR/haet_bench PolygonSettle2D   10 000 hexagons vs 10 000 disks settling, 1 and 2 threads, side by
 #                                           side in one run, with the polygon/disk cost ratio
 # The first run on a machine prepares the flowing states with LAMMPS (10-15 min for 3D, once; kept in
 # bench/data/). Installs the Debian packages lammps and time when missing. Exits non-zero when any part failed,
@@ -38,6 +39,10 @@ done
 
 echo "=== hybrid: HAET vs TDM vs EDM"
 "$here/haet_compare.sh" "$build" || failed="$failed haet"
+echo
+
+echo "=== dilute gas: EDM vs TDM"
+"$here/dilute_compare.sh" "$build" || failed="$failed dilute"
 echo
 
 if [ -x "$build/haet_bench" ]; then

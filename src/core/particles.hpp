@@ -41,8 +41,8 @@ struct Particles {
     std::vector<Vec<D>> x;        ///< centre position [m]
     std::vector<Vec<D>> v;        ///< velocity [m/s]
     std::vector<Ang<D>> w;        ///< angular velocity [rad/s]
-    std::vector<Vec<D>> f;        ///< total force [N]
-    std::vector<Ang<D>> torque;   ///< total torque [N m]
+    std::vector<Vec<D>> f;        ///< total force [N] (empty without hasTdmState())
+    std::vector<Ang<D>> torque;   ///< total torque [N m] (empty without hasTdmState())
     std::vector<double> radius;   ///< [m]
     std::vector<double> invMass;  ///< 1/m [1/kg]; 0 for a frozen particle
     std::vector<double> invInertia;  ///< 1/I [1/(kg m^2)]; 0 for a frozen particle
@@ -50,7 +50,7 @@ struct Particles {
     std::vector<std::uint8_t> flags;      ///< ParticleFlag bits
     // cold
     std::vector<double> mass;     ///< [kg] (kept for frozen particles too, for contact effective mass)
-    std::vector<Ang<D>> angle;    ///< accumulated rotation angle [rad] (2D: orientation)
+    std::vector<Ang<D>> angle;    ///< accumulated rotation angle [rad] (2D: orientation; empty without hasTdmState())
     std::vector<std::uint64_t> id;  ///< stable user-visible id (survives reordering)
     std::vector<Vec<D>> image;    ///< accumulated periodic wraps, for unwrapped positions [m]
     // polygons (2D only). Empty while the store holds no polygon, so disk and sphere runs carry nothing extra.
@@ -62,6 +62,17 @@ struct Particles {
     std::size_t nTdm = static_cast<std::size_t>(-1);
 
     std::size_t size() const { return x.size(); }
+    /// Whether f, torque and angle are kept. Only the time-driven engine reads them (the hybrid too, for its
+    /// time-driven particles); a pure event-driven run applies impulses, not forces, and nothing reads the
+    /// accumulated rotation of a disk or sphere, so it drops them (dropTdmState): 72 of the 211 bytes per sphere.
+    bool hasTdmState() const { return tdmState_; }
+    /// Frees f, torque and angle; particles added later get none either. For a pure event-driven run.
+    void dropTdmState() {
+        tdmState_ = false;
+        std::vector<Vec<D>>().swap(f);
+        std::vector<Ang<D>>().swap(torque);
+        std::vector<Ang<D>>().swap(angle);
+    }
     std::size_t tdmCount() const { return nTdm < x.size() ? nTdm : x.size(); }
 
     /// Appends one particle of given density [kg/m^D-volume]; mass from radius and density.
@@ -71,8 +82,11 @@ struct Particles {
         x.push_back(pos);
         v.push_back(vel);
         w.push_back(spin);
-        f.push_back(Vec<D>::zero());
-        torque.push_back(Ang<D>::zero());
+        if (tdmState_) {
+            f.push_back(Vec<D>::zero());
+            torque.push_back(Ang<D>::zero());
+            angle.push_back(Ang<D>::zero());
+        }
         radius.push_back(r);
         mass.push_back(m);
         const bool frozen = flag & kFrozen;
@@ -80,7 +94,6 @@ struct Particles {
         invInertia.push_back(frozen ? 0.0 : 1.0 / (kInertiaFactor<D> * m * r * r));
         material.push_back(mat);
         flags.push_back(flag);
-        angle.push_back(Ang<D>::zero());
         id.push_back(pid);
         image.push_back(Vec<D>::zero());
         if (!shape.empty()) shape.push_back(kNoShape);
@@ -155,8 +168,10 @@ struct Particles {
     void swapEntries(std::size_t i, std::size_t j) {
         if (i == j) return;
         auto sw = [&](auto& arr) { std::swap(arr[i], arr[j]); };
-        sw(x); sw(v); sw(w); sw(f); sw(torque); sw(radius); sw(invMass); sw(invInertia); sw(material); sw(flags);
-        sw(mass); sw(angle); sw(id); sw(image);
+        sw(x); sw(v); sw(w); sw(radius); sw(invMass); sw(invInertia); sw(material); sw(flags); sw(mass); sw(id);
+        sw(image);
+        if (tdmState_) { sw(f); sw(torque); sw(angle); }
+        if (!shape.empty()) sw(shape);
     }
 
     /// Applies a permutation: new index k holds old particle order[k]. Used for spatial sorting. A shorter order
@@ -167,10 +182,14 @@ struct Particles {
             for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = arr[order[k]];
             arr.swap(tmp);
         };
-        apply(x); apply(v); apply(w); apply(f); apply(torque); apply(radius); apply(invMass);
-        apply(invInertia); apply(material); apply(flags); apply(mass); apply(angle); apply(id); apply(image);
+        apply(x); apply(v); apply(w); apply(radius); apply(invMass); apply(invInertia); apply(material);
+        apply(flags); apply(mass); apply(id); apply(image);
+        if (tdmState_) { apply(f); apply(torque); apply(angle); }
         if (!shape.empty()) apply(shape);
     }
+
+private:
+    bool tdmState_ = true;
 };
 
 }  // namespace haet

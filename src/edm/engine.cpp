@@ -285,7 +285,8 @@ void EdmEngine<D>::advance(std::uint32_t s, double t) {
         h.x = posAt(h, t);
         h.v = velAt(h, t);
         Particles<D>& p = w_.particles;
-        p.angle[rec_[s].idx] += p.w[rec_[s].idx] * dt;  // free rotation between collisions
+        // Free rotation between collisions, when the store keeps angles (a pure event-driven run drops them).
+        if (p.hasTdmState()) p.angle[rec_[s].idx] += p.w[rec_[s].idx] * dt;
     }
     h.t = t;
 }

@@ -63,7 +63,12 @@ class Driver {
 public:
     virtual ~Driver() = default;
     virtual const char* method() const = 0;
+    /// Runs the engine to time t; world.time = t. An engine that moves its particles lazily (the EDM) may leave
+    /// the World's particle state behind: synchronise() brings it to world.time.
     virtual void advanceTo(double t) = 0;
+    /// The run loop calls this before it reads the particles (outputs, the end of the run), not after every
+    /// progress chunk: an EDM synchronisation costs O(N), and 500 chunks of a short run cost more than its events.
+    virtual void synchronise() {}
     /// Time resolution of the engine: the loop treats times closer than this as equal [s].
     virtual double timeTolerance() const = 0;
     virtual std::uint64_t steps() const = 0;          ///< time steps taken (0 for a pure event-driven run)
@@ -108,9 +113,13 @@ private:
 template <int D>
 class EdmDriver final : public Driver<D> {
 public:
-    EdmDriver(World<D>& w, const EdmSettings& s) : eng_(w, s) {}
+    EdmDriver(World<D>& w, const EdmSettings& s) : w_(w), eng_(w, s) {}
     const char* method() const override { return "edm"; }
-    void advanceTo(double t) override { eng_.advanceTo(t); }
+    void advanceTo(double t) override {
+        eng_.advanceEvents(t);
+        w_.time = t;
+    }
+    void synchronise() override { eng_.synchronise(w_.time); }
     double timeTolerance() const override { return 1e-12; }
     std::uint64_t steps() const override { return 0; }
     std::size_t contacts() const override { return 0; }
@@ -128,10 +137,12 @@ public:
     void describe(JsonObject& j) const override {
         j.add("events", eng_.events());
         j.add("collisions", eng_.collisions());
+        j.add("tc_elastic", eng_.stats().tcElastic);
         j.add("tc_time", eng_.tcTime());
     }
 
 private:
+    World<D>& w_;
     EdmEngine<D> eng_;
 };
 
@@ -219,7 +230,9 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
             return std::make_unique<TdmDriver<D>>(world, ts, note);
         }
-        case Method::Edm: return std::make_unique<EdmDriver<D>>(world, edmSettings(sc));
+        case Method::Edm:
+            world.particles.dropTdmState();  // forces, torques and angles: nothing reads them in this run
+            return std::make_unique<EdmDriver<D>>(world, edmSettings(sc));
         case Method::Haet: {
             std::string note;
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
@@ -241,11 +254,12 @@ public:
         std::vector<double> xyz(3 * n, 0.0), vel(3 * n, 0.0), spin(3 * n, 0.0), force(3 * n, 0.0), rad(n);
         std::vector<std::int64_t> ids(n);
         std::vector<std::int32_t> mat(n);
+        const bool forces = p.hasTdmState();  // a pure event-driven run has none: written as zero
         for (std::size_t i = 0; i < n; ++i) {
             for (int k = 0; k < D; ++k) {
                 xyz[3 * i + k] = p.x[i][k];
                 vel[3 * i + k] = p.v[i][k];
-                force[3 * i + k] = p.f[i][k];
+                if (forces) force[3 * i + k] = p.f[i][k];
             }
             if constexpr (D == 2) spin[3 * i + 2] = p.w[i][0];
             else for (int k = 0; k < 3; ++k) spin[3 * i + k] = p.w[i][k];
@@ -492,15 +506,20 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     try {
         for (;;) {
             if (world.time + eps >= nextSeries) {
+                eng->synchronise();
                 writeRow();
                 nextSeries += seriesPeriod;
             }
             if (snapPeriod > 0 && world.time + eps >= nextSnap) {
+                eng->synchronise();
                 snaps.write(world, world.time, eng->hybrid());
                 series.flush();
                 nextSnap += snapPeriod;
             }
-            if (world.time + eps >= sc.duration) break;
+            if (world.time + eps >= sc.duration) {
+                eng->synchronise();
+                break;
+            }
             double target = std::min(sc.duration, nextSeries);
             if (snapPeriod > 0) target = std::min(target, nextSnap);
             while (world.time + eps < target) {
