@@ -152,10 +152,8 @@ public:
     HaetDriver(World<D>& w, const TdmSettings& ts, const EdmSettings& es, const HaetSettings& hs, std::string dtNote)
         : eng_(w, ts, es, hs), note_(std::move(dtNote)) {}
     const char* method() const override { return "haet"; }
-    void advanceTo(double t) override {
-        eng_.advanceTo(t);
-        eng_.synchronise();
-    }
+    void advanceTo(double t) override { eng_.advanceTo(t); }
+    void synchronise() override { eng_.synchronise(); }
     double timeTolerance() const override { return 0.5 * eng_.dt(); }
     std::uint64_t steps() const override { return eng_.steps(); }
     std::size_t contacts() const override { return eng_.tdm().forceStats().contacts; }
