@@ -97,29 +97,50 @@ inline bool testPair(const Particles<D>& p, const Domain<D>& dom, const Neighbor
     return true;
 }
 
-/// Fills first/partner/shift from per-particle candidate lists, sorts each by j, carries history, and builds
-/// the transposed index.
-template <int D>
-void finishList(std::size_t n, std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>>& cand,
-                const PairList<D>& old, PairList<D>& out) {
+/// Lists for each particle i the pairs that candidates(i, add) reports (add(j, code) for each partner j > i and
+/// its image-shift code) into out's first/partner/shift, each particle's sorted by j. Threads take contiguous
+/// particle ranges into flat buffers of their own, copied into place in order: no per-particle vectors.
+template <int D, class Candidates>
+void collectPairs(std::size_t n, const Candidates& candidates, PairList<D>& out) {
     out.first.assign(n + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) out.first[i + 1] = out.first[i] + static_cast<std::uint32_t>(cand[i].size());
-    const std::size_t np = out.first[n];
-    out.partner.resize(np);
-    out.shift.resize(np);
-    out.history.assign(np, Vec<D>::zero());
-    const bool carry = old.first.size() == n + 1 && !old.history.empty();
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
-        auto& c = cand[i];
-        std::sort(c.begin(), c.end());
-        std::uint32_t o = out.first[i];
-        for (const auto& [j, code] : c) {
-            out.partner[o] = j;
-            out.shift[o] = code;
+    std::vector<std::vector<std::uint64_t>> bufs(static_cast<std::size_t>(omp_get_max_threads()));
+#pragma omp parallel if (n >= kParallelMin)
+    {
+        const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
+        const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+        const std::size_t i0 = n * t / nt, i1 = n * (t + 1) / nt;
+        std::vector<std::uint64_t>& buf = bufs[t];  // partner << 8 | code: sorting sorts by partner
+        for (std::size_t i = i0; i < i1; ++i) {
+            const std::size_t start = buf.size();
+            candidates(i, [&](std::uint32_t j, std::uint8_t code) { buf.push_back(std::uint64_t{j} << 8 | code); });
+            std::sort(buf.begin() + static_cast<std::ptrdiff_t>(start), buf.end());
+            out.first[i + 1] = static_cast<std::uint32_t>(buf.size() - start);
+        }
+#pragma omp barrier
+#pragma omp single
+        {
+            for (std::size_t i = 0; i < n; ++i) out.first[i + 1] += out.first[i];
+            out.partner.resize(out.first[n]);
+            out.shift.resize(out.first[n]);
+        }
+        std::uint32_t o = out.first[i0];
+        for (const std::uint64_t c : buf) {
+            out.partner[o] = static_cast<std::uint32_t>(c >> 8);
+            out.shift[o] = static_cast<std::uint8_t>(c & 0xFF);
             ++o;
         }
-        if (carry) {  // merge two j-sorted lists
+    }
+}
+
+/// Carries history from old (same particle numbering) into out and builds the transposed index.
+template <int D>
+void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
+    const std::size_t np = out.first[n];
+    out.history.assign(np, Vec<D>::zero());
+    const bool carry = old.first.size() == n + 1 && !old.history.empty();
+    if (carry) {
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+        for (std::size_t i = 0; i < n; ++i) {  // merge two j-sorted lists
             std::uint32_t a = old.first[i], ae = old.first[i + 1], b = out.first[i], be = out.first[i + 1];
             while (a < ae && b < be) {
                 if (old.partner[a] < out.partner[b]) ++a;
@@ -168,9 +189,7 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
     sortIntoCells(p, g, cellStart, members, cellOf);
     out.shiftVec = makeShiftVectors(dom);
 
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> cand(n);
-#pragma omp parallel for schedule(dynamic, 256) if (n >= kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
+    auto candidates = [&](std::size_t i, auto&& add) {
         std::array<int, D> c;
         for (int k = 0; k < D; ++k) c[k] = g.coord(p.x[i], k);
         // Neighbouring cells, de-duplicated (a periodic axis with fewer than 3 cells maps offsets together).
@@ -194,30 +213,32 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
         }
         std::sort(cells, cells + nc);
         nc = static_cast<int>(std::unique(cells, cells + nc) - cells);
-        auto& ci = cand[i];
         for (int q = 0; q < nc; ++q) {
             for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) {
                 const std::uint32_t j = members[a];
                 if (j <= i) continue;
                 std::uint8_t code;
-                if (testPair(p, dom, s, static_cast<std::uint32_t>(i), j, code)) ci.emplace_back(j, code);
+                if (testPair(p, dom, s, static_cast<std::uint32_t>(i), j, code)) add(j, code);
             }
         }
-    }
-    finishList(n, cand, old, out);
+    };
+    collectPairs(n, candidates, out);
+    finishList(n, old, out);
 }
 
 template <int D>
 void buildAllPairs(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, PairList<D>& out) {
     const std::size_t n = p.tdmCount();
     out.shiftVec = makeShiftVectors(dom);
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> cand(n);
-    for (std::uint32_t i = 0; i < n; ++i)
-        for (std::uint32_t j = i + 1; j < n; ++j) {
+    auto candidates = [&](std::size_t i, auto&& add) {
+        for (std::size_t j = i + 1; j < n; ++j) {
             std::uint8_t code;
-            if (testPair(p, dom, s, i, j, code)) cand[i].emplace_back(j, code);
+            if (testPair(p, dom, s, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), code))
+                add(static_cast<std::uint32_t>(j), code);
         }
-    finishList(n, cand, PairList<D>{}, out);
+    };
+    collectPairs(n, candidates, out);
+    finishList(n, PairList<D>{}, out);
 }
 
 template <int D>
