@@ -115,10 +115,10 @@ template <int D, class Normal, class Tangential>
     if (in.clip && nr.fn < 0) nr.fn = 0;
     out.f = nrm * nr.fn;
     if constexpr (Tangential::kHasHistory) {
-        const Vec<D> g = dv - cross(a.w * ri + in.w[j] * rj, nrm);
-        const Vec<D> gt = g - nrm * dot(g, nrm);
-        const Vec<D> gs = a.sv - in.sv[j] - cross(a.sw * ri + in.sw[j] * rj, nrm);
-        const Vec<D> gst = gs - nrm * dot(gs, nrm);
+        // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
+        const Vec<D> gt = dv - nrm * gn - cross(a.w * ri + in.w[j] * rj, nrm);
+        const Vec<D> ds = a.sv - in.sv[j];
+        const Vec<D> gst = ds - nrm * dot(ds, nrm) - cross(a.sw * ri + in.sw[j] * rj, nrm);
         const Vec<D> ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gst, in.history[k], in.dt);
         out.f += ft;
         out.nxft = cross(nrm, ft);
@@ -166,10 +166,9 @@ template <int D, class Normal, class Tangential, class Then>
             if (in.clip && nr.fn < 0) nr.fn = 0;
             f += nrm * nr.fn;
             if constexpr (Tangential::kHasHistory) {
-                const Vec<D> gg = dv - cross(p.w[i] * ri, nrm);
-                const Vec<D> gt = gg - nrm * dot(gg, nrm);
-                const Vec<D> gs = in.sv[i] - wall.velocity - cross(in.sw[i] * ri, nrm);
-                const Vec<D> gst = gs - nrm * dot(gs, nrm);
+                const Vec<D> gt = dv - nrm * gn - cross(p.w[i] * ri, nrm);
+                const Vec<D> ds = in.sv[i] - wall.velocity;
+                const Vec<D> gst = ds - nrm * dot(ds, nrm) - cross(in.sw[i] * ri, nrm);
                 const Vec<D> ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gst, hist, in.dt);
                 f += ft;
                 tq += cross(nrm, ft) * (-ri);
