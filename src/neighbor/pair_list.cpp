@@ -132,7 +132,7 @@ void collectPairs(std::size_t n, const Candidates& candidates, PairList<D>& out)
     }
 }
 
-/// Carries history from old (same particle numbering) into out and builds the transposed index.
+/// Carries history from old (same particle numbering) into out; the transposed index is left to be built.
 template <int D>
 void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
     const std::size_t np = out.first[n];
@@ -149,13 +149,8 @@ void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
             }
         }
     }
-    // Transposed index, in increasing pair order for each partner (deterministic gather order).
-    out.firstT.assign(n + 1, 0);
-    for (std::size_t k = 0; k < np; ++k) ++out.firstT[out.partner[k] + 1];
-    for (std::size_t i = 0; i < n; ++i) out.firstT[i + 1] += out.firstT[i];
-    out.pairT.resize(np);
-    std::vector<std::uint32_t> fill(out.firstT.begin(), out.firstT.end() - 1);
-    for (std::size_t k = 0; k < np; ++k) out.pairT[fill[out.partner[k]]++] = static_cast<std::uint32_t>(k);
+    out.firstT.clear();
+    out.pairT.clear();
 }
 
 }  // namespace
@@ -227,6 +222,17 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
 }
 
 template <int D>
+void buildTransposedIndex(PairList<D>& list) {
+    const std::size_t n = list.first.size() - 1, np = list.size();
+    list.firstT.assign(n + 1, 0);
+    for (std::size_t k = 0; k < np; ++k) ++list.firstT[list.partner[k] + 1];
+    for (std::size_t i = 0; i < n; ++i) list.firstT[i + 1] += list.firstT[i];
+    list.pairT.resize(np);
+    std::vector<std::uint32_t> fill(list.firstT.begin(), list.firstT.end() - 1);
+    for (std::size_t k = 0; k < np; ++k) list.pairT[fill[list.partner[k]]++] = static_cast<std::uint32_t>(k);
+}
+
+template <int D>
 void buildAllPairs(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, PairList<D>& out) {
     const std::size_t n = p.tdmCount();
     out.shiftVec = makeShiftVectors(dom);
@@ -290,6 +296,7 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     template void buildPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&,              \
                                    const PairList<D>&, PairList<D>&);                                           \
     template void buildAllPairs<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, PairList<D>&); \
+    template void buildTransposedIndex<D>(PairList<D>&);                                                        \
     template void wrapPositions<D>(Particles<D>&, const Domain<D>&);                                            \
     template std::vector<std::uint32_t> spatialOrder<D>(const Particles<D>&, const Domain<D>&, double);         \
     template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);

@@ -240,6 +240,7 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
         return st;
     }
 
+    if (pl.firstT.size() != n + 1) buildTransposedIndex(pl);
     const std::size_t np = pl.size();
     s.pairForce.resize(np);
     s.pairNxFt.resize(np);
