@@ -117,9 +117,8 @@ template <int D, class Normal, class Tangential>
     if constexpr (Tangential::kHasHistory) {
         // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
         const Vec<D> gt = dv - nrm * gn - cross(a.w * ri + in.w[j] * rj, nrm);
-        const Vec<D> ds = a.sv - in.sv[j];
-        const Vec<D> gst = ds - nrm * dot(ds, nrm) - cross(a.sw * ri + in.sw[j] * rj, nrm);
-        const Vec<D> ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gst, in.history[k], in.dt);
+        const Vec<D> gs = a.sv - in.sv[j] - cross(a.sw * ri + in.sw[j] * rj, nrm);
+        const Vec<D> ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, in.history[k], in.dt);
         out.f += ft;
         out.nxft = cross(nrm, ft);
     } else {
@@ -167,9 +166,8 @@ template <int D, class Normal, class Tangential, class Then>
             f += nrm * nr.fn;
             if constexpr (Tangential::kHasHistory) {
                 const Vec<D> gt = dv - nrm * gn - cross(p.w[i] * ri, nrm);
-                const Vec<D> ds = in.sv[i] - wall.velocity;
-                const Vec<D> gst = ds - nrm * dot(ds, nrm) - cross(in.sw[i] * ri, nrm);
-                const Vec<D> ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gst, hist, in.dt);
+                const Vec<D> gs = in.sv[i] - wall.velocity - cross(in.sw[i] * ri, nrm);
+                const Vec<D> ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, hist, in.dt);
                 f += ft;
                 tq += cross(nrm, ft) * (-ri);
             }
