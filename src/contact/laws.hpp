@@ -71,10 +71,9 @@ inline double tsujiAlpha(double e) {
 /// No tangential force.
 struct NoTangential {
     static constexpr bool kHasHistory = false;
-    template <int D>
-    static Vec<D> eval(const PairCoeffs&, double, double, double, const Vec<D>&, const Vec<D>&, const Vec<D>&,
-                       Vec<D>&, double) {
-        return Vec<D>::zero();
+    template <class V>
+    static V eval(const PairCoeffs&, double, double, double, const V&, const V&, const V&, V&, double) {
+        return V::zero();
     }
 };
 
@@ -84,9 +83,9 @@ struct NoTangential {
 /// included (the law removes it), so that xi grows by the true relative displacement.
 struct SpringTangential {
     static constexpr bool kHasHistory = true;
-    template <int D>
-    [[gnu::always_inline]] static inline Vec<D> eval(const PairCoeffs& c, double fn, double kNormal, double meff, const Vec<D>& n,
-                       const Vec<D>& gt, const Vec<D>& gStep, Vec<D>& xi, double dt) {
+    template <class V>  // Vec<D>, or Wide3 (core/wide3.hpp)
+    [[gnu::always_inline]] static inline V eval(const PairCoeffs& c, double fn, double kNormal, double meff,
+                                                const V& n, const V& gt, const V& gStep, V& xi, double dt) {
         // The contact plane turns with the pair: xi is brought into it keeping its length (Luding 2008), then
         // grows by the step's displacement. Both go through one projection P(v) = v - n (n . v), which is linear:
         // P(s xi) + P(g dt) = P(s xi + g dt); and |P(xi)|^2 = |xi|^2 - (n . xi)^2 for a unit n.
@@ -97,11 +96,11 @@ struct SpringTangential {
             const double l2new = len2 - along * along;
             scale = l2new > 0 ? std::sqrt(len2 / l2new) : 0.0;  // a spring along n has no direction left
         }
-        const Vec<D> grown = xi * scale + gStep * dt;
+        const V grown = xi * scale + gStep * dt;
         xi = grown - n * dot(n, grown);
         const double kt = c.ktConst > 0 ? c.ktConst : c.ktRatio * kNormal;
         const double gammaT = c.gtPerMeff * meff;
-        Vec<D> ft = xi * (-kt) - gt * gammaT;
+        V ft = xi * (-kt) - gt * gammaT;
         const double ft2 = norm2(ft);
         const double fmax = c.mu * fn;
         if (ft2 > fmax * fmax) {

@@ -21,6 +21,7 @@
 #include "contact/laws.hpp"
 #include "contact/setup.hpp"
 #include "core/particles.hpp"
+#include "core/wide3.hpp"
 #include "geometry/domain.hpp"
 #include "neighbor/pair_list.hpp"
 
@@ -45,11 +46,33 @@ struct ForceStats {
     std::size_t nonFinite = kNone;   ///< first particle with a non-finite position or force, or kNone
 };
 
+/// The vector type of the contact kernel for N-vectors: Wide3 for 3-vectors when the target has AVX (one register
+/// per vector), Vec<N> otherwise. Results are the same bits either way (core/wide3.hpp).
+template <int N>
+struct KernelVecOf {
+    using type = Vec<N>;
+    static Vec<N> of(const Vec<N>& a) { return a; }
+};
+#ifdef __AVX__
+template <>
+struct KernelVecOf<3> {
+    using type = Wide3;
+    static Wide3 of(const Vec<3>& a) { return Wide3::of(a); }
+};
+#endif
+template <int N>
+using KernelVec = typename KernelVecOf<N>::type;
+template <int N>
+inline KernelVec<N> kernelVec(const Vec<N>& a) { return KernelVecOf<N>::of(a); }
+template <int N>
+inline Vec<N> storedVec(const Vec<N>& a) { return a; }
+inline Vec<3> storedVec(const Wide3& a) { return a.vec(); }
+
 /// Force of one pair: F on i (on j: -F) and n x F_t (torque on each: -a (n x F_t)).
 template <int D>
 struct PairForce {
-    Vec<D> f;
-    Ang<D> nxft;
+    KernelVec<D> f;
+    KernelVec<kAngDim<D>> nxft;
 };
 
 /// Raw views of what the pair kernel reads, taken once per force evaluation: a local copy the stores of the
@@ -77,22 +100,24 @@ struct PairInputs {
 /// Particle i's own data, loaded once for all its pairs.
 template <int D>
 struct Owner {
-    Vec<D> x, v, sv;
-    Ang<D> w, sw;
+    KernelVec<D> x, v, sv;
+    KernelVec<kAngDim<D>> w, sw;
     double radius, invMass;
     const PairCoeffs* coeffRow;  ///< row of i's material in the coefficient table
 
     Owner(const PairInputs<D>& in, std::size_t i)
-        : x(in.x[i]), v(in.v[i]), sv(in.sv[i]), w(in.w[i]), sw(in.sw[i]), radius(in.radius[i]),
-          invMass(in.invMass[i]), coeffRow(in.table + in.material[i] * in.nMaterials) {}
+        : x(kernelVec(in.x[i])), v(kernelVec(in.v[i])), sv(kernelVec(in.sv[i])), w(kernelVec(in.w[i])),
+          sw(kernelVec(in.sw[i])), radius(in.radius[i]), invMass(in.invMass[i]),
+          coeffRow(in.table + in.material[i] * in.nMaterials) {}
 };
 
 /// Evaluates pair slot k of owner a. Returns false when the pair is not touching (its spring is cleared).
 template <int D, class Normal, class Tangential>
 [[gnu::always_inline]] inline bool evalPair(const PairInputs<D>& in, const Owner<D>& a, std::uint32_t k,
                                             PairForce<D>& out, double& overlapRatio, double& virial) {
+    using V = KernelVec<D>;
     const std::uint32_t j = in.partner[k];
-    const Vec<D> d = a.x - in.x[j] + in.shiftVec[in.shift[k]];
+    const V d = a.x - kernelVec(in.x[j]) + kernelVec(in.shiftVec[in.shift[k]]);
     const double ri = a.radius, rj = in.radius[j];
     const double rsum = ri + rj;
     const double dist2 = norm2(d);
@@ -102,13 +127,12 @@ template <int D, class Normal, class Tangential>
         return false;
     }
     const double dist = std::sqrt(dist2);
-    const Vec<D> nrm = d * (1.0 / dist);
+    const V nrm = d * (1.0 / dist);
     const double delta = rsum - dist;
     // A frozen particle has 1/m = 0: it acts as infinitely heavy. (Frozen-frozen pairs are never listed.)
     const double meff = 1.0 / (a.invMass + in.invMass[j]);
     const double reff = ri * rj / rsum;
-    const Vec<D> vj = in.v[j];
-    const Vec<D> dv = a.v - vj;
+    const V dv = a.v - kernelVec(in.v[j]);
     const double gn = dot(dv, nrm);
     const PairCoeffs& c = a.coeffRow[in.material[j]];
     NormalResult nr = Normal::eval(c, delta, -gn, meff, reff);
@@ -116,13 +140,15 @@ template <int D, class Normal, class Tangential>
     out.f = nrm * nr.fn;
     if constexpr (Tangential::kHasHistory) {
         // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
-        const Vec<D> gt = dv - nrm * gn - cross(a.w * ri + in.w[j] * rj, nrm);
-        const Vec<D> gs = a.sv - in.sv[j] - cross(a.sw * ri + in.sw[j] * rj, nrm);
-        const Vec<D> ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, in.history[k], in.dt);
+        const V gt = dv - nrm * gn - cross(a.w * ri + kernelVec(in.w[j]) * rj, nrm);
+        const V gs = a.sv - kernelVec(in.sv[j]) - cross(a.sw * ri + kernelVec(in.sw[j]) * rj, nrm);
+        V xi = kernelVec(in.history[k]);
+        const V ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, xi, in.dt);
+        in.history[k] = storedVec(xi);
         out.f += ft;
         out.nxft = cross(nrm, ft);
     } else {
-        out.nxft = Ang<D>::zero();
+        out.nxft = KernelVec<kAngDim<D>>::zero();
     }
     virial += dot(d, out.f);
     overlapRatio = std::max(overlapRatio, delta / std::min(ri, rj));
@@ -211,8 +237,8 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
         }
         for (std::size_t i = 0; i < n; ++i) {
             const Owner<D> a(in, i);
-            Vec<D> fi = f[i];
-            Ang<D> nxi = nx[i];
+            KernelVec<D> fi = kernelVec(f[i]);
+            KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
             double worst = 0, vir = 0;
             std::uint32_t nc = 0;
             for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
@@ -221,12 +247,12 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
                 const std::uint32_t j = in.partner[k];
                 fi += pf.f;
                 nxi += pf.nxft;
-                f[j] -= pf.f;
-                nx[j] += pf.nxft;
+                f[j] = storedVec(kernelVec(f[j]) - pf.f);
+                nx[j] = storedVec(kernelVec(nx[j]) + pf.nxft);
                 ++nc;
             }
-            const ParticleTally t = finishParticle<D, Normal, Tangential>(p, in, walls, wh, cs, time, i, fi, nxi,
-                                                                          worst, nc, then);
+            const ParticleTally t = finishParticle<D, Normal, Tangential>(
+                p, in, walls, wh, cs, time, i, storedVec(fi), storedVec(nxi), worst, nc, then);
             st.contacts += t.contacts;
             st.virial += vir;
             if (t.worst > st.maxOverlapRatio) {
@@ -259,12 +285,12 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
                 PairForce<D> pf;
                 if (evalPair<D, Normal, Tangential>(in, a, k, pf, worst, vir)) {
                     ++nc;
+                    pairForce[k] = storedVec(pf.f);
+                    pairNxFt[k] = storedVec(pf.nxft);
                 } else {
-                    pf.f = Vec<D>::zero();
-                    pf.nxft = Ang<D>::zero();
+                    pairForce[k] = Vec<D>::zero();
+                    pairNxFt[k] = Ang<D>::zero();
                 }
-                pairForce[k] = pf.f;
-                pairNxFt[k] = pf.nxft;
             }
             s.maxOverlap[i] = worst;
             s.contacts[i] = nc;
