@@ -50,4 +50,26 @@ inline Wide3 cross(const Wide3& a, const Wide3& b) {
     return {a1 * b1 - a2 * b2};
 }
 
+/// The vector type of hot loops for N-vectors: Wide3 for 3-vectors when the target has AVX (one register per
+/// vector), Vec<N> otherwise. Results are the same bits either way. kernelVec() loads, storedVec() stores.
+template <int N>
+struct KernelVecOf {
+    using type = Vec<N>;
+    static Vec<N> of(const Vec<N>& a) { return a; }
+};
+#ifdef __AVX__
+template <>
+struct KernelVecOf<3> {
+    using type = Wide3;
+    static Wide3 of(const Vec<3>& a) { return Wide3::of(a); }
+};
+#endif
+template <int N>
+using KernelVec = typename KernelVecOf<N>::type;
+template <int N>
+inline KernelVec<N> kernelVec(const Vec<N>& a) { return KernelVecOf<N>::of(a); }
+template <int N>
+inline Vec<N> storedVec(const Vec<N>& a) { return a; }
+inline Vec<3> storedVec(const Wide3& a) { return a.vec(); }
+
 }  // namespace haet

@@ -46,28 +46,6 @@ struct ForceStats {
     std::size_t nonFinite = kNone;   ///< first particle with a non-finite position or force, or kNone
 };
 
-/// The vector type of the contact kernel for N-vectors: Wide3 for 3-vectors when the target has AVX (one register
-/// per vector), Vec<N> otherwise. Results are the same bits either way (core/wide3.hpp).
-template <int N>
-struct KernelVecOf {
-    using type = Vec<N>;
-    static Vec<N> of(const Vec<N>& a) { return a; }
-};
-#ifdef __AVX__
-template <>
-struct KernelVecOf<3> {
-    using type = Wide3;
-    static Wide3 of(const Vec<3>& a) { return Wide3::of(a); }
-};
-#endif
-template <int N>
-using KernelVec = typename KernelVecOf<N>::type;
-template <int N>
-inline KernelVec<N> kernelVec(const Vec<N>& a) { return KernelVecOf<N>::of(a); }
-template <int N>
-inline Vec<N> storedVec(const Vec<N>& a) { return a; }
-inline Vec<3> storedVec(const Wide3& a) { return a.vec(); }
-
 /// Force of one pair: F on i (on j: -F) and n x F_t (torque on each: -a (n x F_t)).
 template <int D>
 struct PairForce {
