@@ -45,8 +45,9 @@ double error(bool gear, int n) {
         integ->start(p, dt);
     }
     StepMotion<2> m;
+    const std::vector<Vec<2>> ref = p.x;
     for (int k = 0; k < n; ++k) {
-        integ->predict(p, dt, m);
+        integ->predict(p, dt, m, ref.data(), 1e300);
         force();
         integ->correct(p, dt);
     }

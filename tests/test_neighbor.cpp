@@ -1,6 +1,7 @@
 // The cell-grid pair list against its reference twin, all-pairs (2D and 3D, periodic and walled, polydisperse).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 #include <tuple>
@@ -45,7 +46,11 @@ void compareWithAllPairs(std::array<bool, D> periodic, double boxLen, unsigned s
     ASSERT_GT(ref.size(), 100u);
     EXPECT_EQ(pairSet(fast), pairSet(ref));
     // transposed index covers every pair exactly once
+    buildTransposedIndex(fast);
     EXPECT_EQ(fast.pairT.size(), fast.size());
+    std::vector<int> seen(fast.size(), 0);
+    for (std::uint32_t k : fast.pairT) ++seen[k];
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(fast.size()));
 }
 
 TEST(Neighbor, CellListMatchesAllPairs3D) {
@@ -134,6 +139,7 @@ void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed, std::size_t 
     PairList<D> ref;
     buildPairList(all, dom, s, PairList<D>{}, ref);
     EXPECT_EQ(pairSet(list), pairSet(ref));
+    buildTransposedIndex(list);
     EXPECT_EQ(list.pairT.size(), list.size());
     std::size_t kept = 0;
     for (std::size_t i = 0; i < nT; ++i)

@@ -1,4 +1,6 @@
 // The `haet` command line: run and check scenarios, plot CSV tables. Exit codes: 0 ok, 2 bad input, 3 simulation blew up.
+#include <malloc.h>
+
 #include <CLI/CLI.hpp>
 #include <iostream>
 
@@ -10,6 +12,11 @@
 #include "scenario/loader.hpp"
 
 int main(int argc, char** argv) {
+    // Large buffers (pair lists rebuilt every ~100 steps, file contents at set-up) go straight to the system
+    // and back when freed. By default glibc raises this threshold to the size of the last freed buffer, after
+    // which buffers come from the heap and the freed ones stay resident (3D chute benchmark, 1 500 steps: peak
+    // resident memory 30.8 MB with the default, 27.8 MB with this).
+    mallopt(M_MMAP_THRESHOLD, 256 * 1024);
     CLI::App app{"HAET: granular flows with time-driven DEM, event-driven dynamics and their hybrid"};
     app.set_version_flag("--version", std::string("haet ") + haet::kVersion);
     app.require_subcommand(1);

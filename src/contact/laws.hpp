@@ -71,32 +71,36 @@ inline double tsujiAlpha(double e) {
 /// No tangential force.
 struct NoTangential {
     static constexpr bool kHasHistory = false;
-    template <int D>
-    static Vec<D> eval(const PairCoeffs&, double, double, double, const Vec<D>&, const Vec<D>&, const Vec<D>&,
-                       Vec<D>&, double) {
-        return Vec<D>::zero();
+    template <class V>
+    static V eval(const PairCoeffs&, double, double, double, const V&, const V&, const V&, V&, double) {
+        return V::zero();
     }
 };
 
 /// Cundall-Strack tangential spring with Coulomb limit and history (B.4).
 /// xi: the spring elongation [m], kept per contact; gt: tangential relative velocity of the contact points
-/// (for the damping); gStep: its mean over the last step, so that xi grows by the true relative displacement.
+/// (for the damping); gStep: the relative velocity of the contact points averaged over the last step, normal part
+/// included (the law removes it), so that xi grows by the true relative displacement.
 struct SpringTangential {
     static constexpr bool kHasHistory = true;
-    template <int D>
-    [[gnu::always_inline]] static inline Vec<D> eval(const PairCoeffs& c, double fn, double kNormal, double meff, const Vec<D>& n,
-                       const Vec<D>& gt, const Vec<D>& gStep, Vec<D>& xi, double dt) {
-        // The contact plane turns with the pair: project xi onto it and keep its length (Luding 2008).
+    template <class V>  // Vec<D>, or Wide3 (core/wide3.hpp)
+    [[gnu::always_inline]] static inline V eval(const PairCoeffs& c, double fn, double kNormal, double meff,
+                                                const V& n, const V& gt, const V& gStep, V& xi, double dt) {
+        // The contact plane turns with the pair: xi is brought into it keeping its length (Luding 2008), then
+        // grows by the step's displacement. Both go through one projection P(v) = v - n (n . v), which is linear:
+        // P(s xi) + P(g dt) = P(s xi + g dt); and |P(xi)|^2 = |xi|^2 - (n . xi)^2 for a unit n.
         const double len2 = norm2(xi);
+        double scale = 1;
         if (len2 > 0) {
-            xi -= n * dot(n, xi);
-            const double l2new = norm2(xi);
-            if (l2new > 0) xi *= std::sqrt(len2 / l2new);
+            const double along = dot(n, xi);
+            const double l2new = len2 - along * along;
+            scale = l2new > 0 ? std::sqrt(len2 / l2new) : 0.0;  // a spring along n has no direction left
         }
-        xi += gStep * dt;
+        const V grown = xi * scale + gStep * dt;
+        xi = grown - n * dot(n, grown);
         const double kt = c.ktConst > 0 ? c.ktConst : c.ktRatio * kNormal;
         const double gammaT = c.gtPerMeff * meff;
-        Vec<D> ft = xi * (-kt) - gt * gammaT;
+        V ft = xi * (-kt) - gt * gammaT;
         const double ft2 = norm2(ft);
         const double fmax = c.mu * fn;
         if (ft2 > fmax * fmax) {

@@ -46,8 +46,8 @@ struct Vec {
 
 template <int N>
 constexpr double dot(const Vec<N>& a, const Vec<N>& b) {
-    double s = 0;
-    for (int k = 0; k < N; ++k) s += a[k] * b[k];
+    double s = a[0] * b[0];  // not 0 + ...: the compiler must keep an add of +0 (it turns -0 into +0)
+    for (int k = 1; k < N; ++k) s += a[k] * b[k];
     return s;
 }
 template <int N>

@@ -138,41 +138,50 @@ inline bool testPair(const Particles<D>& p, const Domain<D>& dom, const Neighbor
     return true;
 }
 
-/// Transposed index, in increasing pair order for each partner (deterministic gather order).
-template <int D>
-void buildTransposed(std::size_t n, PairList<D>& out) {
-    const std::size_t np = out.partner.size();
-    out.firstT.assign(n + 1, 0);
-    for (std::size_t k = 0; k < np; ++k) ++out.firstT[out.partner[k] + 1];
-    for (std::size_t i = 0; i < n; ++i) out.firstT[i + 1] += out.firstT[i];
-    out.pairT.resize(np);
-    std::vector<std::uint32_t> fill(out.firstT.begin(), out.firstT.end() - 1);
-    for (std::size_t k = 0; k < np; ++k) out.pairT[fill[out.partner[k]]++] = static_cast<std::uint32_t>(k);
-}
-
-/// Fills first/partner/shift from per-particle candidate lists, sorts each by j, carries history, and builds
-/// the transposed index.
-template <int D>
-void finishList(std::size_t n, std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>>& cand,
-                const PairList<D>& old, PairList<D>& out) {
+/// Lists for each particle i the pairs that candidates(i, add) reports (add(j, code) for each partner j > i and
+/// its image-shift code) into out's first/partner/shift, each particle's sorted by j. Threads take contiguous
+/// particle ranges into flat buffers of their own, copied into place in order: no per-particle vectors.
+template <int D, class Candidates>
+void collectPairs(std::size_t n, const Candidates& candidates, PairList<D>& out) {
     out.first.assign(n + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) out.first[i + 1] = out.first[i] + static_cast<std::uint32_t>(cand[i].size());
-    const std::size_t np = out.first[n];
-    out.partner.resize(np);
-    out.shift.resize(np);
-    out.history.assign(np, Vec<D>::zero());
-    const bool carry = old.first.size() == n + 1 && !old.history.empty();
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
-        auto& c = cand[i];
-        std::sort(c.begin(), c.end());
-        std::uint32_t o = out.first[i];
-        for (const auto& [j, code] : c) {
-            out.partner[o] = j;
-            out.shift[o] = code;
+    std::vector<std::vector<std::uint64_t>> bufs(static_cast<std::size_t>(omp_get_max_threads()));
+#pragma omp parallel if (n >= kParallelMin)
+    {
+        const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
+        const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+        const std::size_t i0 = n * t / nt, i1 = n * (t + 1) / nt;
+        std::vector<std::uint64_t>& buf = bufs[t];  // partner << 8 | code: sorting sorts by partner
+        for (std::size_t i = i0; i < i1; ++i) {
+            const std::size_t start = buf.size();
+            candidates(i, [&](std::uint32_t j, std::uint8_t code) { buf.push_back(std::uint64_t{j} << 8 | code); });
+            std::sort(buf.begin() + static_cast<std::ptrdiff_t>(start), buf.end());
+            out.first[i + 1] = static_cast<std::uint32_t>(buf.size() - start);
+        }
+#pragma omp barrier
+#pragma omp single
+        {
+            for (std::size_t i = 0; i < n; ++i) out.first[i + 1] += out.first[i];
+            out.partner.resize(out.first[n]);
+            out.shift.resize(out.first[n]);
+        }
+        std::uint32_t o = out.first[i0];
+        for (const std::uint64_t c : buf) {
+            out.partner[o] = static_cast<std::uint32_t>(c >> 8);
+            out.shift[o] = static_cast<std::uint8_t>(c & 0xFF);
             ++o;
         }
-        if (carry) {  // merge two j-sorted lists
+    }
+}
+
+/// Carries history from old (same particle numbering) into out; the transposed index is left to be built.
+template <int D>
+void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
+    const std::size_t np = out.first[n];
+    out.history.assign(np, Vec<D>::zero());
+    const bool carry = old.first.size() == n + 1 && !old.history.empty();
+    if (carry) {
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+        for (std::size_t i = 0; i < n; ++i) {  // merge two j-sorted lists
             std::uint32_t a = old.first[i], ae = old.first[i + 1], b = out.first[i], be = out.first[i + 1];
             while (a < ae && b < be) {
                 if (old.partner[a] < out.partner[b]) ++a;
@@ -181,7 +190,8 @@ void finishList(std::size_t n, std::vector<std::vector<std::pair<std::uint32_t, 
             }
         }
     }
-    buildTransposed(n, out);
+    out.firstT.clear();
+    out.pairT.clear();
 }
 
 }  // namespace
@@ -208,9 +218,11 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                    PairList<D>& out) {
     const std::size_t n = p.tdmCount();
     if (n == 0) {  // no particles (a hybrid run whose particles are all event-driven): no grid either
-        std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> none;
         out.shiftVec = makeShiftVectors(dom);
-        finishList(0, none, old, out);
+        out.first.assign(1, 0);
+        out.partner.clear();
+        out.shift.clear();
+        finishList(0, old, out);
         return;
     }
     double rmax = 0;
@@ -221,35 +233,46 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
     sortIntoCells(p, g, cellStart, members, cellOf);
     out.shiftVec = makeShiftVectors(dom);
 
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> cand(n);
-#pragma omp parallel for schedule(dynamic, 256) if (n >= kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
+    auto candidates = [&](std::size_t i, auto&& add) {
         int cells[27];
         const int nc = neighbourCells(g, dom, p.x[i], cells);
-        auto& ci = cand[i];
         for (int q = 0; q < nc; ++q) {
             for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) {
                 const std::uint32_t j = members[a];
                 if (j <= i) continue;
                 std::uint8_t code;
-                if (testPair(p, dom, s, static_cast<std::uint32_t>(i), j, code)) ci.emplace_back(j, code);
+                if (testPair(p, dom, s, static_cast<std::uint32_t>(i), j, code)) add(j, code);
             }
         }
-    }
-    finishList(n, cand, old, out);
+    };
+    collectPairs(n, candidates, out);
+    finishList(n, old, out);
+}
+
+template <int D>
+void buildTransposedIndex(PairList<D>& list) {
+    const std::size_t n = list.first.size() - 1, np = list.size();
+    list.firstT.assign(n + 1, 0);
+    for (std::size_t k = 0; k < np; ++k) ++list.firstT[list.partner[k] + 1];
+    for (std::size_t i = 0; i < n; ++i) list.firstT[i + 1] += list.firstT[i];
+    list.pairT.resize(np);
+    std::vector<std::uint32_t> fill(list.firstT.begin(), list.firstT.end() - 1);
+    for (std::size_t k = 0; k < np; ++k) list.pairT[fill[list.partner[k]]++] = static_cast<std::uint32_t>(k);
 }
 
 template <int D>
 void buildAllPairs(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, PairList<D>& out) {
     const std::size_t n = p.tdmCount();
     out.shiftVec = makeShiftVectors(dom);
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> cand(n);
-    for (std::uint32_t i = 0; i < n; ++i)
-        for (std::uint32_t j = i + 1; j < n; ++j) {
+    auto candidates = [&](std::size_t i, auto&& add) {
+        for (std::size_t j = i + 1; j < n; ++j) {
             std::uint8_t code;
-            if (testPair(p, dom, s, i, j, code)) cand[i].emplace_back(j, code);
+            if (testPair(p, dom, s, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), code))
+                add(static_cast<std::uint32_t>(j), code);
         }
-    finishList(n, cand, PairList<D>{}, out);
+    };
+    collectPairs(n, candidates, out);
+    finishList(n, PairList<D>{}, out);
 }
 
 template <int D>
@@ -352,7 +375,8 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 std::swap(list.history[q - 1], list.history[q]);
             }
     list.shiftVec = makeShiftVectors(dom);
-    buildTransposed(n, list);
+    list.firstT.clear();  // the transposed index is built by the threaded force loop when it needs it
+    list.pairT.clear();
 }
 
 template <int D>
@@ -395,6 +419,7 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     template void buildPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&,              \
                                    const PairList<D>&, PairList<D>&);                                           \
     template void buildAllPairs<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, PairList<D>&); \
+    template void buildTransposedIndex<D>(PairList<D>&);                                                        \
     template void wrapPositions<D>(Particles<D>&, const Domain<D>&);                                            \
     template std::vector<std::uint32_t> spatialOrder<D>(const Particles<D>&, const Domain<D>&, double);         \
     template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);                        \

@@ -153,12 +153,15 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
     const bool threaded = n >= kParallelMin && omp_get_max_threads() > 1;
 
     // One pair, whichever its kind: force on i and the torques on i and j.
+    const PairInputs<2> in{p.x.data(),        p.v.data(),      p.w.data(),         p.radius.data(),
+                           p.invMass.data(),  p.material.data(), sv,               sw,
+                           pl.partner.data(), pl.shift.data(), pl.shiftVec.data(), pl.history.data(),
+                           table,             nm,              clip,               dt};
     auto pair = [&](std::size_t i, std::uint32_t k, PairResult& r, double& worst, double& vir) {
         const std::uint32_t j = pl.partner[k];
         if (p.shape[i] == kNoShape && p.shape[j] == kNoShape) {
             PairForce<2> pf;
-            if (!evalPair<2, Normal, Tangential>(p, pl, table, nm, clip, sv, sw, dt, i, k, pf, worst, vir))
-                return false;
+            if (!evalPair<2, Normal, Tangential>(in, Owner<2>(in, i), k, pf, worst, vir)) return false;
             r.f = pf.f;
             r.ti = -p.radius[i] * pf.nxft[0];
             r.tj = -p.radius[j] * pf.nxft[0];
@@ -189,6 +192,7 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
             s.virial[i] = vir;
         }
     } else {
+        if (pl.firstT.size() != n + 1) buildTransposedIndex(pl);  // built on first use after a list build
         s.pairForce.resize(np);
         ps.torqueI.resize(np);
         ps.torqueJ.resize(np);

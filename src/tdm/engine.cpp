@@ -14,15 +14,18 @@ TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s
         throw std::invalid_argument("time-driven engine: the particle store has dropped forces and angles");
     if constexpr (D == 2)
         if (w_.particles.hasPolygons()) poly_ = std::make_unique<polygon::PolygonScratch>();
-    if (s.integrator == IntegratorKind::Gear5)
+    if (s.integrator == IntegratorKind::Gear5) {
         integ_ = std::make_unique<Gear5<D>>();
-    else
-        integ_ = std::make_unique<VelocityVerlet<D>>();
+    } else {
+        auto vv = std::make_unique<VelocityVerlet<D>>();
+        verlet_ = vv.get();
+        integ_ = std::move(vv);
+    }
     wallHistory_.assign(w_.particles.tdmCount() * w_.walls.size(), Vec<D>::zero());
-    rebuildIfNeeded(true);
+    rebuild(s_.sortEvery > 0);
     motion_.v = w_.particles.v;
     motion_.w = w_.particles.w;
-    computeForces();
+    computeForces(false);
     integ_->start(w_.particles, s_.dt);
 }
 
@@ -30,8 +33,9 @@ template <int D>
 TdmEngine<D>::~TdmEngine() = default;
 
 template <int D>
-void TdmEngine<D>::computeForces() {
+void TdmEngine<D>::computeForces(bool correct) {
     const ContactSetup& cs = w_.contact;
+    bool corrected = false;
     auto run = [&](auto normal, auto tangential) {
         using N = decltype(normal);
         using T = decltype(tangential);
@@ -40,11 +44,30 @@ void TdmEngine<D>::computeForces() {
                 stats_ = polygon::computePolygonForces<N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs,
                                                              w_.domain, w_.time, s_.dt, motion_.v.data(),
                                                              motion_.w.data(), scratch_, *poly_);
+                // The disk loop checks finiteness and sums the virial as it goes; the polygon loop leaves both.
+                const Particles<D>& p = w_.particles;
+                stats_.virial = 0;
+                for (double v : scratch_.virial) stats_.virial += v;
+                for (std::size_t i = 0; i < p.tdmCount() && stats_.nonFinite == ForceStats::kNone; ++i) {
+                    double sum = 0;
+                    for (int k = 0; k < D; ++k) sum += p.f[i][k] + p.x[i][k];
+                    if (!std::isfinite(sum)) stats_.nonFinite = i;
+                }
                 return;
             }
         }
-        stats_ = haet::computeForces<D, N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain, w_.time,
-                                              s_.dt, motion_.v.data(), motion_.w.data(), scratch_);
+        auto forces = [&](auto then) {
+            stats_ = haet::computeForces<D, N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain,
+                                                  w_.time, s_.dt, motion_.v.data(), motion_.w.data(), scratch_,
+                                                  then);
+        };
+        // Verlet's corrector needs nothing but the particle's own new force: it runs inside the force pass.
+        if (correct && verlet_) {
+            forces(verlet_->corrector(w_.particles, s_.dt));
+            corrected = true;
+        } else {
+            forces([](std::size_t) {});
+        }
     };
     auto withTangential = [&](auto normal) {
         if (cs.tangential == TangentialLaw::Spring)
@@ -58,21 +81,7 @@ void TdmEngine<D>::computeForces() {
         withTangential(HertzTsujiNormal{});
     else
         withTangential(HertzViscoNormal{});  // A* = 0 is the undamped Hertz law
-}
-
-template <int D>
-void TdmEngine<D>::rebuildIfNeeded(bool force) {
-    Particles<D>& p = w_.particles;
-    const std::size_t n = p.tdmCount();
-    if (!force) {
-        const double lim2 = 0.25 * s_.skin * s_.skin;
-        bool moved = false;
-#pragma omp parallel for schedule(static) reduction(|| : moved) if (n >= kParallelMin)
-        for (std::size_t i = 0; i < n; ++i)
-            if (norm2(p.x[i] - xAtBuild_[i]) > lim2) moved = true;
-        if (!moved) return;
-    }
-    rebuild(s_.sortEvery > 0 && (force || steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery)));
+    if (correct && !corrected) integ_->correct(w_.particles, s_.dt);
 }
 
 template <int D>
@@ -172,12 +181,12 @@ void TdmEngine<D>::contactCounts(std::vector<std::uint8_t>& out) const {
 template <int D>
 void TdmEngine<D>::step() {
     Particles<D>& p = w_.particles;
-    integ_->predict(p, s_.dt, motion_);
+    const bool moved = integ_->predict(p, s_.dt, motion_, xAtBuild_.data(), 0.25 * s_.skin * s_.skin);
     w_.time += s_.dt;
     ++steps_;
-    rebuildIfNeeded(false);
-    computeForces();
-    integ_->correct(p, s_.dt);
+    if (moved)
+        rebuild(s_.sortEvery > 0 && steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery));
+    computeForces(true);
     checkHealth();
 }
 
@@ -201,13 +210,7 @@ void TdmEngine<D>::checkHealth() const {
         os << "overlap " << stats_.maxOverlapRatio << " x radius exceeds max_overlap = " << s_.maxOverlap;
         fail(stats_.worstParticle, os.str());
     }
-    // A NaN anywhere reaches the force of its particle in the same step.
-    for (std::size_t i = 0; i < p.tdmCount(); ++i) {
-        const Vec<D>& f = p.f[i];
-        double s = 0;
-        for (int k = 0; k < D; ++k) s += f[k] + p.x[i][k];
-        if (!std::isfinite(s)) fail(i, "non-finite position or force");
-    }
+    if (stats_.nonFinite != ForceStats::kNone) fail(stats_.nonFinite, "non-finite position or force");
 }
 
 template <int D>
@@ -246,9 +249,7 @@ double TdmEngine<D>::contactEnergy() const {
 
 template <int D>
 double TdmEngine<D>::pairVirial() const {
-    double s = 0;
-    for (double v : scratch_.virial) s += v;
-    return s;
+    return stats_.virial;
 }
 
 template class TdmEngine<2>;

@@ -1,6 +1,7 @@
 #pragma once
 // Time-driven DEM engine: soft disks (2D) and spheres (3D) with the shared contact laws.
-// One step: predict -> (rebuild pair list if any particle moved more than skin/2) -> forces -> correct.
+// One step: predict (and the skin test) -> (rebuild the pair list if any particle moved more than skin/2) ->
+// forces -> correct.
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -59,14 +60,15 @@ public:
     double pairVirial() const;
 
 private:
-    void computeForces();
-    void rebuildIfNeeded(bool force);
+    /// Forces at the current (predicted) state; with correct, also the integrator's corrector.
+    void computeForces(bool correct);
     void rebuild(bool sort);
     void checkHealth() const;
 
     World<D>& w_;
     TdmSettings s_;
     std::unique_ptr<Integrator<D>> integ_;
+    VelocityVerlet<D>* verlet_ = nullptr;  ///< integ_ when it is velocity Verlet (its corrector is fused)
     PairList<D> pairs_;
     ForceScratch<D> scratch_;
     StepMotion<D> motion_;

@@ -41,7 +41,7 @@ void VelocityVerlet<D>::start(const Particles<D>& p, double) {
 }
 
 template <int D>
-void VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
+bool VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) {
     const std::size_t n = p.tdmCount();
     const double h2 = 0.5 * dt * dt;
     m.v.resize(n);
@@ -56,7 +56,8 @@ void VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
     const Vec<D>* __restrict acc = acc_.data();
     const Ang<D>* __restrict alpha = alpha_.data();
     const std::uint8_t* __restrict flags = p.flags.data();
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    bool moved = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
         if (flags[i] & kFrozen) {
             mv[i] = v[i];
@@ -69,32 +70,17 @@ void VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
         v[i] += acc[i] * dt;
         ang[i] += w[i] * dt + alpha[i] * h2;
         w[i] += alpha[i] * dt;
+        moved |= norm2(x[i] - ref[i]) > limit2;
     }
+    return moved;
 }
 
 template <int D>
 void VelocityVerlet<D>::correct(Particles<D>& p, double dt) {
     const std::size_t n = p.tdmCount();
-    const double h = 0.5 * dt;
-    Vec<D>* __restrict v = p.v.data();
-    Ang<D>* __restrict w = p.w.data();
-    Vec<D>* __restrict acc = acc_.data();
-    Ang<D>* __restrict alpha = alpha_.data();
-    const Vec<D>* __restrict f = p.f.data();
-    const Ang<D>* __restrict tq = p.torque.data();
-    const double* __restrict im = p.invMass.data();
-    const double* __restrict ii = p.invInertia.data();
-    const std::uint8_t* __restrict flags = p.flags.data();
+    const Corrector c = corrector(p, dt);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
-        if (flags[i] & kFrozen) continue;
-        const Vec<D> a = f[i] * im[i];
-        const Ang<D> al = tq[i] * ii[i];
-        v[i] += (a - acc[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
-        w[i] += (al - alpha[i]) * h;
-        acc[i] = a;
-        alpha[i] = al;
-    }
+    for (std::size_t i = 0; i < n; ++i) c(i);
 }
 
 template <int D>
@@ -195,11 +181,12 @@ inline void gearCorrect(Vec<N>& x, Vec<N>& v, Vec<N>& y2, Vec<N>& y3, Vec<N>& y4
 }  // namespace
 
 template <int D>
-void Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
+bool Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) {
     const std::size_t n = p.tdmCount();
     m.v.resize(n);
     m.w.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    bool moved = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
         if (p.flags[i] & kFrozen) {
             m.v[i] = p.v[i];
@@ -208,7 +195,9 @@ void Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m) {
         }
         gearPredict(p.x[i], p.v[i], y_[0][i], y_[1][i], y_[2][i], y_[3][i], dt, m.v[i]);
         gearPredict(p.angle[i], p.w[i], r_[0][i], r_[1][i], r_[2][i], r_[3][i], dt, m.w[i]);
+        moved |= norm2(p.x[i] - ref[i]) > limit2;
     }
+    return moved;
 }
 
 template <int D>

@@ -3,7 +3,8 @@
 // predict() moves positions and velocities to t + dt (velocities as the estimate the velocity-dependent forces
 // see) and reports each particle's mean velocity over the step (displacement / dt), which drives the tangential
 // spring so that its elongation is the true relative displacement of the contact points; correct() applies the
-// new forces. Frozen particles are never moved.
+// new forces. Frozen particles are never moved. predict() also tells whether a particle has moved farther than a
+// given distance from a reference position (the pair list's skin test), so the engine reads positions once.
 #include <cstdint>
 #include <vector>
 
@@ -24,7 +25,9 @@ public:
     virtual ~Integrator() = default;
     /// Called once after the first force evaluation, with forces at the initial state.
     virtual void start(const Particles<D>& p, double dt) = 0;
-    virtual void predict(Particles<D>& p, double dt, StepMotion<D>& m) = 0;
+    /// Returns whether some particle is now farther than sqrt(limit2) from ref[i] (its position at the last
+    /// pair-list build).
+    virtual bool predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) = 0;
     virtual void correct(Particles<D>& p, double dt) = 0;
     /// Reorders per-particle history after Particles::permute(order).
     virtual void permute(const std::vector<std::uint32_t>& order) = 0;
@@ -40,11 +43,30 @@ template <int D>
 class VelocityVerlet final : public Integrator<D> {
 public:
     void start(const Particles<D>& p, double dt) override;
-    void predict(Particles<D>& p, double dt, StepMotion<D>& m) override;
+    bool predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) override;
     void correct(Particles<D>& p, double dt) override;
     void permute(const std::vector<std::uint32_t>& order) override;
     void restart(const Particles<D>& p, std::size_t i, double dt) override;
     void remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) override;
+
+    /// The corrector of one particle, for a force loop that finishes particles one at a time (TdmEngine runs it
+    /// inside the force pass); correct() runs it over all particles.
+    struct Corrector {
+        Particles<D>& p;
+        Vec<D>* acc;
+        Ang<D>* alpha;
+        double h;  ///< dt / 2 [s]
+        void operator()(std::size_t i) const {
+            if (p.flags[i] & kFrozen) return;
+            const Vec<D> a = p.f[i] * p.invMass[i];
+            const Ang<D> al = p.torque[i] * p.invInertia[i];
+            p.v[i] += (a - acc[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
+            p.w[i] += (al - alpha[i]) * h;
+            acc[i] = a;
+            alpha[i] = al;
+        }
+    };
+    Corrector corrector(Particles<D>& p, double dt) { return {p, acc_.data(), alpha_.data(), 0.5 * dt}; }
 
 private:
     std::vector<Vec<D>> acc_;    ///< a(t) [m/s^2]
@@ -59,7 +81,7 @@ public:
     static constexpr double kC[6] = {3.0 / 16.0, 251.0 / 360.0, 1.0, 11.0 / 18.0, 1.0 / 6.0, 1.0 / 60.0};
 
     void start(const Particles<D>& p, double dt) override;
-    void predict(Particles<D>& p, double dt, StepMotion<D>& m) override;
+    bool predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) override;
     void correct(Particles<D>& p, double dt) override;
     void permute(const std::vector<std::uint32_t>& order) override;
     void restart(const Particles<D>& p, std::size_t i, double dt) override;
