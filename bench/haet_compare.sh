@@ -25,14 +25,8 @@ N=${SWEEP_N:-4000}
 FRACTIONS=${FRACTIONS:-"0.5 0.75 0.9 0.95"}
 [ -x /usr/bin/time ] || { echo "$0: needs /usr/bin/time (Debian package time)" >&2; exit 1; }
 
-# run NAME SCENARIO: runs one scenario on one thread; sets CPU (s) and WALL (s).
-run() {
-    local name=$1 scenario=$2
-    /usr/bin/time -f "%U %S %e" -o "$out/$name.time" "$haet" run "$scenario" --out "$out/$name" --threads 1 --quiet
-    read -r user sys wall <"$out/$name.time"
-    CPU=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.2f", u + s }')
-    WALL=$wall
-}
+# shellcheck source=bench/lib.sh
+. "$here/lib.sh"
 
 # mean of column COL of a series.csv
 mean_col() { awk -F, -v name="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i; next }

@@ -405,6 +405,26 @@ std::vector<NewParticle<D>> insertFromFile(const Scenario& s, std::size_t k) {
     return out;
 }
 
+/// The material column of a particle file: a material name or its index.
+template <class Fail>
+int materialCell(std::string_view text, const std::vector<MaterialDef>& materials, const Fail& fail) {
+    for (std::size_t m = 0; m < materials.size(); ++m)
+        if (materials[m].name == text) return int(m);
+    const auto idx = parseInteger(text);
+    if (idx && *idx >= 0 && std::size_t(*idx) < materials.size()) return int(*idx);
+    fail("column material: unknown material " + inQuotes(text));
+    return -1;
+}
+
+/// The frozen column of a particle file: 0, 1, true or false.
+template <class Fail>
+bool frozenCell(std::string_view text, const Fail& fail) {
+    if (text == "1" || text == "true") return true;
+    if (text == "0" || text == "false") return false;
+    fail("column frozen: expected 0, 1, true or false, got " + inQuotes(text));
+    return false;
+}
+
 }  // namespace
 
 ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
@@ -473,25 +493,8 @@ ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
             p.v[1] = number(Vy);
             if (dimension == 3) p.v[2] = number(Vz);
         }
-        if (col[Material] >= 0) {
-            const std::string_view text = cells[std::size_t(col[Material])];
-            for (std::size_t m = 0; m < materials.size(); ++m)
-                if (materials[m].name == text) p.material = int(m);
-            if (p.material < 0) {
-                const auto idx = parseInteger(text);
-                if (idx && *idx >= 0 && std::size_t(*idx) < materials.size()) p.material = int(*idx);
-            }
-            if (p.material < 0) fail("column material: unknown material " + inQuotes(text));
-        }
-        if (col[Frozen] >= 0) {
-            const std::string_view text = cells[std::size_t(col[Frozen])];
-            if (text == "1" || text == "true")
-                p.frozen = true;
-            else if (text == "0" || text == "false")
-                p.frozen = false;
-            else
-                fail("column frozen: expected 0, 1, true or false, got " + inQuotes(text));
-        }
+        if (col[Material] >= 0) p.material = materialCell(cells[std::size_t(col[Material])], materials, fail);
+        if (col[Frozen] >= 0) p.frozen = frozenCell(cells[std::size_t(col[Frozen])], fail);
         out.particles.push_back(p);
     }
     if (!haveHeader) throw ScenarioError({name, 0}, key, "empty particle file: no header line");
@@ -561,25 +564,8 @@ std::vector<FilePolygon> readPolygonCsv(const std::filesystem::path& file, const
             p.v[1] = number(Vy);
         }
         if (col[W] >= 0) p.w = number(W);
-        if (col[Material] >= 0) {
-            const std::string_view text = cells[std::size_t(col[Material])];
-            for (std::size_t m = 0; m < materials.size(); ++m)
-                if (materials[m].name == text) p.material = int(m);
-            if (p.material < 0) {
-                const auto idx = parseInteger(text);
-                if (idx && *idx >= 0 && std::size_t(*idx) < materials.size()) p.material = int(*idx);
-            }
-            if (p.material < 0) fail("column material: unknown material " + inQuotes(text));
-        }
-        if (col[Frozen] >= 0) {
-            const std::string_view text = cells[std::size_t(col[Frozen])];
-            if (text == "1" || text == "true")
-                p.frozen = true;
-            else if (text == "0" || text == "false")
-                p.frozen = false;
-            else
-                fail("column frozen: expected 0, 1, true or false, got " + inQuotes(text));
-        }
+        if (col[Material] >= 0) p.material = materialCell(cells[std::size_t(col[Material])], materials, fail);
+        if (col[Frozen] >= 0) p.frozen = frozenCell(cells[std::size_t(col[Frozen])], fail);
         out.push_back(std::move(p));
     }
     if (!haveHeader) throw ScenarioError({name, 0}, key, "empty polygon file: no header line");
