@@ -10,6 +10,27 @@
 
 namespace haet {
 
+namespace {
+/// The impulse on body 1 of a collision along n (gn: normal velocity of body 1's contact point relative to body 2's):
+/// the law's, with the normal speed after it raised to uRest when it would be smaller (the rest hop, docs/edm.md);
+/// a pair not approaching (only with uRest > gn) gets a normal impulse up to uRest. hop: the speed was raised.
+template <int D>
+Vec<D> impulseWithHop(const CollisionBody<D>& b1, const CollisionBody<D>& b2, const Vec<D>& n, CollisionLaw law,
+                      bool approaching, double gn, double uRest, bool& hop) {
+    if (!approaching) {  // resting on the obstacle
+        hop = true;
+        return n * ((uRest - gn) / (b1.invMass + b2.invMass));
+    }
+    CollisionImpulse<D> imp = collisionImpulse(b1, b2, n, law);
+    if (uRest > 0 && -imp.e * imp.gn < uRest) {
+        law.e = uRest / -imp.gn;
+        imp = collisionImpulse(b1, b2, n, law);
+        hop = true;
+    }
+    return imp.impulse;
+}
+}  // namespace
+
 // Arithmetic is canonical on purpose: a pair's collision time is computed from the two particles' stored states
 // extrapolated to the later of their two clocks (never to "now"), in a form that is bit-identical for (a, b) and
 // (b, a); the collision operator always takes the particle of lower World index as body 1. The prediction of a pair
@@ -623,21 +644,8 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     advance(a, t);
     advance(b, t);
     const bool elastic = tcElastic(a, fb ? kNil : b, t);
-    CollisionLaw law = lawFor(p.material[i], p.material[j], elastic);
-    Vec<D> P;
     bool hop = false;
-    if (approaching) {
-        CollisionImpulse<D> imp = collisionImpulse(b1, b2, n, law);
-        if (uRest > 0 && -imp.e * imp.gn < uRest) {
-            law.e = uRest / -imp.gn;
-            imp = collisionImpulse(b1, b2, n, law);
-            hop = true;
-        }
-        P = imp.impulse;
-    } else {  // resting on the obstacle: a normal impulse up to the rest-hop speed
-        P = n * ((uRest - gn) / (b1.invMass + b2.invMass));
-        hop = true;
-    }
+    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(p.material[i], p.material[j], elastic), approaching, gn, uRest, hop);
     const double before = kineticEnergy(b1) + kineticEnergy(b2);
     applyImpulse(b1, b2, n, P);
     stats_.dissipated += before - kineticEnergy(b1) - kineticEnergy(b2);
@@ -680,21 +688,8 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     }
     advance(s, t);
     const bool elastic = tcElastic(s, kNil, t);
-    CollisionLaw law = lawFor(p.material[i], wl.material, elastic);
-    Vec<D> P;
     bool hop = false;
-    if (gn < 0) {
-        CollisionImpulse<D> imp = collisionImpulse(b1, b2, n, law);
-        if (uRest > 0 && -imp.e * imp.gn < uRest) {
-            law.e = uRest / -imp.gn;
-            imp = collisionImpulse(b1, b2, n, law);
-            hop = true;
-        }
-        P = imp.impulse;
-    } else {
-        P = n * ((uRest - gn) / b1.invMass);
-        hop = true;
-    }
+    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(p.material[i], wl.material, elastic), gn < 0, gn, uRest, hop);
     const double before = kineticEnergy(b1);
     applyImpulse(b1, b2, n, P);
     stats_.dissipated += before - kineticEnergy(b1);

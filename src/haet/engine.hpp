@@ -67,6 +67,8 @@ public:
     std::uint64_t events() const { return edm_->events(); }
     std::uint64_t collisions() const { return edm_->collisions(); }
     const HaetCounters& counters() const { return counters_; }
+    /// The event-driven collisions' virial since the last call (EdmEngine::takeCollisionVirial) [J].
+    double takeCollisionVirial() { return edm_->takeCollisionVirial(); }
     /// Energy accounting at world.time (call synchronise() first).
     HaetEnergy energy() const;
 

@@ -160,7 +160,8 @@ public:
     double maxOverlapRatio() const override { return eng_.tdm().forceStats().maxOverlapRatio; }
     double elasticEnergy() const override { return eng_.tdm().contactEnergy(); }
     double virial(double window) override {
-        return eng_.tdm().pairVirial() + (window > 0 ? edmVirial() / window : 0.0);
+        const double collisions = eng_.takeCollisionVirial();
+        return eng_.tdm().pairVirial() + (window > 0 ? collisions / window : 0.0);
     }
     std::vector<std::string> extraColumns() const override {
         return {"n_tdm", "n_edm", "events", "collisions", "tdm_steps", "to_tdm", "to_edm", "tc_handovers",
@@ -192,7 +193,6 @@ public:
     const HaetEngine<D>* hybrid() const override { return &eng_; }
 
 private:
-    double edmVirial() { return const_cast<EdmEngine<D>&>(eng_.edm()).takeCollisionVirial(); }
     HaetEngine<D> eng_;
     std::string note_;
 };

@@ -405,6 +405,24 @@ std::vector<NewParticle<D>> insertFromFile(const Scenario& s, std::size_t k) {
     return out;
 }
 
+/// The header row of a particle file: col[j] = the cell holding column names[j], or -1. An unknown or repeated
+/// name fails; `known` lists the names for the message.
+template <std::size_t N, class Fail>
+std::array<int, N> headerColumns(const std::vector<std::string_view>& cells, const char* const (&names)[N],
+                                 const char* known, const Fail& fail) {
+    std::array<int, N> col;
+    col.fill(-1);
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+        int which = -1;
+        for (std::size_t j = 0; j < N; ++j)
+            if (cells[c] == names[j]) which = int(j);
+        if (which < 0) fail("unknown column " + inQuotes(cells[c]) + " (" + known + ")");
+        if (col[std::size_t(which)] >= 0) fail("column " + inQuotes(cells[c]) + " appears twice");
+        col[std::size_t(which)] = int(c);
+    }
+    return col;
+}
+
 /// The material column of a particle file: a material name or its index.
 template <class Fail>
 int materialCell(std::string_view text, const std::vector<MaterialDef>& materials, const Fail& fail) {
@@ -449,18 +467,12 @@ ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
         if (!haveHeader) {
             haveHeader = true;
             fields = cells.size();
-            for (std::size_t c = 0; c < cells.size(); ++c) {
-                int which = -1;
-                for (int j = 0; j < kColumns; ++j)
-                    if (cells[c] == columnName[j]) which = j;
-                if (which < 0)
-                    fail("unknown column " + inQuotes(cells[c]) +
-                         " (the header names columns x, y, z, radius, vx, vy, vz, material, frozen)");
-                if (col[std::size_t(which)] >= 0) fail("column " + inQuotes(cells[c]) + " appears twice");
-                if (dimension == 2 && (which == Z || which == Vz))
-                    fail("column " + inQuotes(cells[c]) + " is not used in a 2D scenario");
-                col[std::size_t(which)] = int(c);
-            }
+            col = headerColumns(cells, columnName, "the header names columns x, y, z, radius, vx, vy, vz, material, frozen",
+                                fail);
+            if (dimension == 2)
+                for (int j : {int(Z), int(Vz)})
+                    if (col[std::size_t(j)] >= 0)
+                        fail(std::string("column ") + inQuotes(columnName[j]) + " is not used in a 2D scenario");
             for (int j : {int(X), int(Y), int(Z), int(Radius)}) {
                 if (j == Z && dimension == 2) continue;
                 if (col[std::size_t(j)] < 0) fail(std::string("missing column ") + inQuotes(columnName[j]));
@@ -522,16 +534,8 @@ std::vector<FilePolygon> readPolygonCsv(const std::filesystem::path& file, const
         if (!haveHeader) {
             haveHeader = true;
             fields = cells.size();
-            for (std::size_t c = 0; c < cells.size(); ++c) {
-                int which = -1;
-                for (int j = 0; j < kColumns; ++j)
-                    if (cells[c] == columnName[j]) which = j;
-                if (which < 0)
-                    fail("unknown column " + inQuotes(cells[c]) +
-                         " (a polygon file names columns vertices, vx, vy, w, material, frozen)");
-                if (col[std::size_t(which)] >= 0) fail("column " + inQuotes(cells[c]) + " appears twice");
-                col[std::size_t(which)] = int(c);
-            }
+            col = headerColumns(cells, columnName, "a polygon file names columns vertices, vx, vy, w, material, frozen",
+                                fail);
             if (col[Vertices] < 0) fail("missing column \"vertices\"");
             if ((col[Vx] >= 0) != (col[Vy] >= 0)) fail("velocity columns vx, vy go together");
             continue;
