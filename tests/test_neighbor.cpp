@@ -166,5 +166,36 @@ TEST(Neighbor, RemapAfterModeChangeMatchesBuild2D) {
     remapMatchesBuild<2>({false, true}, 26, 3);
 }
 
+/// A kept particle that drifted away from a newcomer since the last build may drift back by skin/2 before the next
+/// one, while the newcomer drifts skin/2 towards it: the newcomer must be paired with it within skin + its drift.
+/// Pair list valid: every touching pair is listed while each particle stays within skin/2 of its reference.
+TEST(Neighbor, RemapCountsTheKeptParticlesDrift) {
+    Domain<2> dom;
+    dom.lo = Vec<2>::zero();
+    dom.hi = Vec<2>::filled(1.0);
+    const double r = 0.01, skin = 0.004;
+    Particles<2> p;
+    p.add(Vec<2>{0.5, 0.5}, Vec<2>::zero(), Ang<2>::zero(), r, 1000, 0, 0, 0);  // kept
+    p.add(Vec<2>{0.9, 0.9}, Vec<2>::zero(), Ang<2>::zero(), r, 1000, 0, 1, 0);  // joins later
+    p.nTdm = 1;
+    const NeighborSettings s{skin, true};
+    PairList<2> list;
+    buildPairList(p, dom, s, PairList<2>{}, list);
+    const Vec<2> ref0 = p.x[0];
+    p.x[0][0] -= 0.49 * skin;                                  // drifts away, within skin/2
+    p.x[1] = Vec<2>{p.x[0][0] + 2 * r + 1.01 * skin, 0.5};     // joins just beyond the plain reach
+    p.nTdm = 2;
+    const std::vector<Vec<2>> ref{ref0, p.x[1]};
+    PairList<2> plain = list, drifting = list;
+    remapPairList(p, dom, s, {0, 0xFFFFFFFFu}, plain);
+    remapPairList(p, dom, s, {0, 0xFFFFFFFFu}, drifting, ref.data());
+    // Both move skin/2 - epsilon towards each other from their references: they touch.
+    p.x[0][0] = ref0[0] + 0.49 * skin;
+    p.x[1][0] -= 0.49 * skin;
+    ASSERT_LT(norm(p.x[0] - p.x[1]), 2 * r);
+    EXPECT_EQ(drifting.size(), 1u);
+    EXPECT_EQ(plain.size(), 0u) << "without the drift the newcomer is left out (the case the reference is for)";
+}
+
 }  // namespace
 }  // namespace haet

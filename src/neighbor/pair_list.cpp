@@ -117,7 +117,7 @@ std::vector<Vec<D>> makeShiftVectors(const Domain<D>& dom) {
 /// Tests pair (i, j); on success appends it with its minimum-image shift code.
 template <int D>
 inline bool testPair(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, std::uint32_t i,
-                     std::uint32_t j, std::uint8_t& code) {
+                     std::uint32_t j, std::uint8_t& code, double extra = 0) {
     if (s.excludeFrozenPairs && (p.flags[i] & p.flags[j] & kFrozen)) return false;
     Vec<D> d = p.x[i] - p.x[j];
     int cd = 0, mul = 1;
@@ -132,7 +132,7 @@ inline bool testPair(const Particles<D>& p, const Domain<D>& dom, const Neighbor
         cd += (sk + 1) * mul;
         mul *= 3;
     }
-    const double cut = p.radius[i] + p.radius[j] + s.skin;
+    const double cut = p.radius[i] + p.radius[j] + s.skin + extra;
     if (norm2(d) >= cut * cut) return false;
     code = static_cast<std::uint8_t>(cd);
     return true;
@@ -287,7 +287,7 @@ std::vector<std::uint32_t> spatialOrder(const Particles<D>& p, const Domain<D>& 
 
 template <int D>
 void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s,
-                   const std::vector<std::uint32_t>& from, PairList<D>& list) {
+                   const std::vector<std::uint32_t>& from, PairList<D>& list, const Vec<D>* ref) {
     constexpr std::uint32_t kNone = 0xFFFFFFFFu;
     constexpr std::uint8_t kMirror = (D == 2) ? 8 : 26;  // shift code of (j, i) = kMirror - code of (i, j)
     const std::size_t n = from.size();
@@ -323,6 +323,10 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 entries.push_back({b, a, static_cast<std::uint8_t>(kMirror - list.shift[k]), -h});
         }
     }
+    // A kept particle j may have drifted by d_j from where its pairs were last searched, and may drift back the
+    // other way by skin/2 before the next build: a new particle is paired with it within skin + d_j, so that no
+    // pair left out can touch while every particle stays within skin/2 of its reference.
+    auto drift = [&](std::uint32_t j) { return ref && !fresh[j] ? norm(p.x[j] - ref[j]) : 0.0; };
     // A few new particles are tested against all (a grid costs O(cells), and a tall box has many); many use a grid.
     if (!freshList.empty() && freshList.size() * 64 <= n) {
         for (const std::uint32_t f : freshList)
@@ -330,12 +334,15 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 if (j == f || (fresh[j] && j < f)) continue;
                 const std::uint32_t lo = std::min(f, j), hi = std::max(f, j);
                 std::uint8_t code;
-                if (testPair(p, dom, s, lo, hi, code)) entries.push_back({lo, hi, code, Vec<D>::zero()});
+                if (testPair(p, dom, s, lo, hi, code, drift(j))) entries.push_back({lo, hi, code, Vec<D>::zero()});
             }
     } else if (!freshList.empty()) {
         double rmax = 0;
         for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
-        const Grid<D> g(dom, std::max(2 * rmax + s.skin, 1e-300), p);
+        double reach = 0;
+        if (ref)
+            for (std::uint32_t j = 0; j < n; ++j) reach = std::max(reach, drift(j));
+        const Grid<D> g(dom, std::max(2 * rmax + s.skin + reach, 1e-300), p);
         std::vector<std::uint32_t> cellStart, members;
         std::vector<int> cellOf;
         sortIntoCells(p, g, cellStart, members, cellOf);
@@ -348,7 +355,8 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                     if (j == f || (fresh[j] && j < f)) continue;  // a pair of two new particles once
                     const std::uint32_t lo = std::min(f, j), hi = std::max(f, j);
                     std::uint8_t code;
-                    if (testPair(p, dom, s, lo, hi, code)) entries.push_back({lo, hi, code, Vec<D>::zero()});
+                    if (testPair(p, dom, s, lo, hi, code, drift(j)))
+                        entries.push_back({lo, hi, code, Vec<D>::zero()});
                 }
         }
     }
@@ -424,7 +432,7 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     template std::vector<std::uint32_t> spatialOrder<D>(const Particles<D>&, const Domain<D>&, double);         \
     template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);                        \
     template void remapPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&,               \
-                                   const std::vector<std::uint32_t>&, PairList<D>&);
+                                   const std::vector<std::uint32_t>&, PairList<D>&, const Vec<D>*);
 HAET_INSTANTIATE(2)
 HAET_INSTANTIATE(3)
 #undef HAET_INSTANTIATE

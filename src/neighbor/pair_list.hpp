@@ -60,11 +60,13 @@ std::vector<std::uint32_t> spatialOrder(const Particles<D>& p, const Domain<D>& 
 /// before; new particle k was old particle from[k], or is new to the list (any value >= the old count). Keeps every
 /// pair of two kept particles with its shift and history, drops those of particles that left, and adds the pairs
 /// of the new particles found with a cell grid at the current positions. Positions are not wrapped, so the shift
-/// codes of kept pairs stay valid. The list stays valid for as long as no particle moves more than skin/2 from
-/// where it was at its own inclusion (kept particles: their last build).
+/// codes of kept pairs stay valid. ref (new numbering, may be null): where each kept particle's drift is measured
+/// from (its position at the last build); a new particle is paired with kept particle j within skin + |x_j - ref_j|.
+/// The list then stays valid for as long as no particle moves more than skin/2 from its reference (new particles:
+/// their position now). Without ref, kept particles are taken not to have drifted.
 template <int D>
 void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s,
-                   const std::vector<std::uint32_t>& from, PairList<D>& list);
+                   const std::vector<std::uint32_t>& from, PairList<D>& list, const Vec<D>* ref = nullptr);
 
 /// Renumbers a pair list's history after Particles::permute(order), so it can be carried into the next build.
 /// new particle k was old particle order[k]; entries outside the old range (a particle new to the list) have no

@@ -151,10 +151,10 @@ void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
     integ_->remap(p, from, s_.dt);
     // The pair list follows incrementally (kept pairs, plus the new particles' pairs found now); the drift check
     // then measures each particle from where it entered the list.
-    remapPairList(p, w_.domain, NeighborSettings{s_.skin, true}, from, pairs_);
     std::vector<Vec<D>> xb(n);
     for (std::size_t k = 0; k < n; ++k) xb[k] = from[k] == kFresh ? p.x[k] : xAtBuild_[from[k]];
     xAtBuild_.swap(xb);
+    remapPairList(p, w_.domain, NeighborSettings{s_.skin, true}, from, pairs_, xAtBuild_.data());
 }
 
 template <int D>
