@@ -208,6 +208,49 @@ TEST(HaetEngine, UniformlyDiluteRunsAsPureEdm) {
     testing::record("collisions", double(h.collisions()));
 }
 
+/// The event grid's default edge (docs/haet.md): K / ((D - 1) 3^(D-1)) event-driven particles per cell at their
+/// density, within [largest diameter + skin, zone edge]; the grid's cells are that edge rounded up to fit the box.
+TEST(HaetEngine, EventGridEdgeFollowsTheDilutePartsDensity) {
+    auto edge = [](int dim, int count, double side) {
+        std::string lo = dim == 2 ? "[0.0, 0.0]" : "[0.0, 0.0, 0.0]";
+        std::string hi = dim == 2 ? "[S, S]" : "[S, S, S]";
+        std::string per = dim == 2 ? "[true, true]" : "[true, true, true]";
+        hi.replace(hi.find('S'), 1, std::to_string(side));
+        while (hi.find('S') != std::string::npos) hi.replace(hi.find('S'), 1, std::to_string(side));
+        const std::string text = "name = 'gas'\ndimension = " + std::to_string(dim) +
+                                 "\nduration = 1\nseed = 3\n[domain]\nlo = " + lo + "\nhi = " + hi +
+                                 "\nperiodic = " + per +
+                                 "\n[materials.m]\ndensity = 2500\nrestitution = 0.9\nfriction = 0.3\n"
+                                 "[contact]\nnormal = 'linear'\nduration = 1e-5\n"
+                                 "[[insert]]\narrangement = 'random'\ncount = " + std::to_string(count) +
+                                 "\nradius = 0.0005\nmaterial = 'm'\ntemperature = 1.0\n";
+        const Scenario sc = parseScenario(text, "gas.toml");
+        double cell = 0;
+        auto run = [&](auto dimTag) {
+            constexpr int D = decltype(dimTag)::value;
+            World<D> w = buildWorld<D>(sc);
+            const HaetEngine<D> h(w, tdmSettings<D>(sc, w), EdmSettings{}, HaetSettings{});
+            EXPECT_EQ(h.nTdm(), 0u);
+            cell = h.edm().cellSize();
+        };
+        if (dim == 2)
+            run(std::integral_constant<int, 2>{});
+        else
+            run(std::integral_constant<int, 3>{});
+        return cell;
+    };
+    // 3D, 650 spheres in (20 mm)^3: 20 / 18 particles per cell at n = 650 / (20 mm)^3 gives 2.39 mm, between
+    // diameter + skin (1.1 mm) and the zone edge (4 mm); 8 cells of 2.5 mm fit the box.
+    const double h3 = std::cbrt(20.0 / 18 / (650 / 8e-6));
+    EXPECT_GE(edge(3, 650, 0.02), h3);
+    EXPECT_LT(edge(3, 650, 0.02), 1.1 * h3);
+    // Four times as dense: a smaller edge, down to diameter + skin.
+    EXPECT_LT(edge(3, 2600, 0.02), 0.7 * h3);
+    EXPECT_GE(edge(3, 2600, 0.02), 1.1e-3);
+    // 2D, 60 disks in (40 mm)^2: 20 / 3 per cell would need 21 mm, more than the zone edge (4 mm).
+    EXPECT_NEAR(edge(2, 60, 0.04), 0.04 / std::floor(0.04 / 0.004), 1e-12);
+}
+
 /// A hot lattice filling a periodic box: the hybrid never leaves the TDM and reproduces the pure TDM run exactly.
 template <int D>
 void uniformlyDenseRunsAsPureTdm() {

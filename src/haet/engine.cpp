@@ -52,11 +52,13 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
     p.permute(order);
     p.nTdm = nT;
 
-    // The event grid's cells hold one particle diameter plus the TDM skin: a particle in a cell next to a TDM
-    // particle's cell is at least a skin's width from touching it (docs/haet.md).
+    // The event grid's cells hold at least one particle diameter plus the TDM skin: a particle in a cell next to a
+    // TDM particle's cell is at least a skin's width from touching it (docs/haet.md). Unless the scenario sets it,
+    // the edge balances cell crossings against candidates per prediction for the event-driven particles' density.
     edm.firstParticle = nT;
     edm.tcTime = hs_.dtMin > 0 ? hs_.dtMin : w_.contact.contactTime;
     edm.tcModel = true;
+    if (!(edm.cellSize > 0)) edm.cellSize = eventCellEdge(nT);
     edm.cellSize = std::max(edm.cellSize, 2 * rmax + ts_.skin);
     edm_ = std::make_unique<EdmEngine<D>>(w_, edm);
     const std::array<int, D>& nc = edm_->cellDims();
@@ -92,6 +94,29 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
 
 template <int D>
 HaetEngine<D>::~HaetEngine() = default;
+
+// An event-driven particle flying a distance L crosses about L / h cells of edge h, and each crossing scans the
+// 3^(D-1) newly adjacent cells, n h^D particles each at number density n. With a crossing's fixed cost worth
+// kCrossingCost candidate tests, the cost per distance, (kCrossingCost + 3^(D-1) n h^D) / h, is least at
+// n h^D = kCrossingCost / ((D - 1) 3^(D-1)) particles per cell. n: the event-driven particles per volume of the
+// zones they occupy at the start. The edge stays within [largest diameter + skin, zone edge] (docs/haet.md).
+template <int D>
+double HaetEngine<D>::eventCellEdge(std::size_t nT) const {
+    const Particles<D>& p = w_.particles;
+    const std::size_t n = p.size();
+    if (n == nT) return 0;
+    std::vector<std::uint8_t> occupied(static_cast<std::size_t>(zones_.count()), 0);
+    std::size_t zones = 0;
+    for (std::size_t i = nT; i < n; ++i) {
+        std::uint8_t& o = occupied[zones_.zoneOf(p.x[i])];
+        zones += o == 0;
+        o = 1;
+    }
+    const double density = static_cast<double>(n - nT) / (static_cast<double>(zones) * zones_.zoneVolume());
+    constexpr double kCrossingCost = 20;
+    const double perCell = kCrossingCost / ((D - 1) * (D == 2 ? 3.0 : 9.0));
+    return std::min(std::pow(perCell / density, 1.0 / D), hs_.zones.size);
+}
 
 // ---------------------------------------------------------------------------------------------------------------
 

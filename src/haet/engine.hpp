@@ -96,6 +96,8 @@ private:
     void relabel(std::vector<std::uint32_t> arrivals, bool due);
     void checkWatched(std::vector<std::uint32_t>& arrivals, bool due);
     void convert(std::vector<std::uint32_t> arrivals, std::vector<std::uint32_t> departures);
+    /// The default edge of the event grid's cells, for particles [nT, size()) event-driven [m].
+    double eventCellEdge(std::size_t nT) const;
     void bin(const Vec<D>& x, double r);
     /// The 3^D cells around `cell` get at least guard `level` (new-level bits during a relabel); occupants of a
     /// cell that became stricter are watched.

@@ -625,6 +625,9 @@ void describeHaet(const Scenario& sc, std::ostream& out) {
                        "relabel every {} steps, dilute_steps {}\n",
                        hs.zones.size, dims, hs.zones.phiOn, hs.zones.phiOff, hs.zones.buffer, hs.relabelEvery,
                        hs.diluteSteps);
+    out << fmt::format("events     cell edge {:.4g} m ({})\n", eng.edm().cellSize(),
+                       sc.edm.cellSize ? "[edm] cell_size, at least one diameter plus the skin"
+                                       : "from the event-driven particles' density, docs/haet.md");
     out << fmt::format("collapse   modified EDM: dt_min = {:.4g} s (a collision sooner hands both particles to the TDM)\n",
                        eng.dtMin());
     for (std::size_t a = 0; a < sc.materials.size(); ++a)
