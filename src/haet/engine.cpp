@@ -327,25 +327,36 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
     }
     for (std::size_t b = 0, nb = binCells_.size(); b < nb; ++b) markAround(binCells_[b], 1);
     // A candidate within reach of a staying TDM particle, or whose event-grid cell belongs to a time-driven zone,
-    // stays (it would be handed back at once); so may its neighbours then.
-    std::vector<std::uint32_t> departures;
-    for (bool changed = true; changed;) {
-        changed = false;
-        std::size_t keep = 0;
-        for (const std::uint32_t i : candidates) {
-            const std::uint32_t c = edm_->cellIndex(p.x[i]);
-            if ((guard_[c] >> 2) >= 2 || gapToTdm(p.x[i], p.radius[i]) < margin_) {
-                const bool fresh = binHead_[c] == kNil;
-                bin(p.x[i], p.radius[i]);
-                if (fresh) markAround(c, 1);
-                changed = true;
-                continue;
+    // stays (it would be handed back at once); so may its neighbours then: a candidate that stays puts the
+    // candidates of the cells around it back on the work list.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> byCell;  // (cell, candidate), sorted
+    byCell.reserve(candidates.size());
+    for (const std::uint32_t i : candidates) byCell.emplace_back(edm_->cellIndex(p.x[i]), i);
+    std::sort(byCell.begin(), byCell.end());
+    std::vector<std::uint8_t> stays(byCell.size(), 0);
+    std::vector<std::size_t> work(byCell.size());
+    for (std::size_t q = 0; q < work.size(); ++q) work[q] = work.size() - 1 - q;
+    while (!work.empty()) {
+        const std::size_t q = work.back();
+        work.pop_back();
+        if (stays[q]) continue;
+        const auto [c, i] = byCell[q];
+        if ((guard_[c] >> 2) < 2 && gapToTdm(p.x[i], p.radius[i]) >= margin_) continue;
+        stays[q] = 1;
+        const bool fresh = binHead_[c] == kNil;
+        bin(p.x[i], p.radius[i]);
+        if (fresh) markAround(c, 1);
+        edm_->forEachNeighbourCell(c, [&](std::uint32_t idx) {
+            auto at = std::lower_bound(byCell.begin(), byCell.end(), std::make_pair(idx, std::uint32_t{0}));
+            for (; at != byCell.end() && at->first == idx; ++at) {
+                const std::size_t r = static_cast<std::size_t>(at - byCell.begin());
+                if (!stays[r]) work.push_back(r);
             }
-            candidates[keep++] = i;
-        }
-        candidates.resize(keep);
+        });
     }
-    departures = std::move(candidates);
+    std::vector<std::uint32_t> departures;
+    for (std::size_t q = 0; q < byCell.size(); ++q)
+        if (!stays[q]) departures.push_back(byCell[q].second);
     // Settle the guard: new levels replace old ones.
     for (const std::uint32_t c : guardList_) guard_[c] = static_cast<std::uint8_t>(guard_[c] & ~3u);
     for (const std::uint32_t c : newList_) guard_[c] = static_cast<std::uint8_t>(guard_[c] >> 2);
