@@ -1,13 +1,17 @@
 #include "io/png.hpp"
 
 #include <algorithm>
+#include <csetjmp>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <vector>
 
 #include <cairo.h>
 #include <fmt/format.h>
+#include <png.h>
 
 #include "io/atomic_file.hpp"
 
@@ -43,19 +47,52 @@ void setColor(cairo_t* cr, std::uint32_t rgb, double alpha = 1.0) {
     cairo_set_source_rgba(cr, ((rgb >> 16) & 0xff) / 255.0, ((rgb >> 8) & 0xff) / 255.0, (rgb & 0xff) / 255.0, alpha);
 }
 
-// Cairo's write callback. It must not throw through C code: errors stay in the stream and commit() reports them.
-cairo_status_t writeChunk(void* closure, const unsigned char* data, unsigned int length) {
-    auto* out = static_cast<AtomicOfstream*>(closure);
+void pngWrite(png_structp png, png_bytep data, png_size_t length) {
+    auto* out = static_cast<AtomicOfstream*>(png_get_io_ptr(png));
     out->write(data, length);
-    return out->stream() ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
+}
+
+void pngFlush(png_structp) {}
+
+/// Encodes Cairo's RGB24 pixels as an 8-bit RGB PNG with the fastest zlib level and the "sub" filter: pictures
+/// of disks on a white ground compress about as well as with libpng's defaults (level 6, the filter chosen per
+/// row) at a small fraction of the time. Returns false if libpng failed (its errors jump back here).
+bool encodePng(const unsigned char* pixels, int width, int height, int stride, AtomicOfstream& out) {
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    if (!png) return false;
+    png_infop info = png_create_info_struct(png);
+    std::vector<png_byte> row(3 * static_cast<std::size_t>(width));
+    if (!info || setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return false;
+    }
+    png_set_write_fn(png, &out, pngWrite, pngFlush);
+    png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
+                 PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_compression_level(png, 1);
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+    png_write_info(png, info);
+    for (int y = 0; y < height; ++y) {
+        const auto* src = reinterpret_cast<const std::uint32_t*>(pixels + static_cast<std::ptrdiff_t>(y) * stride);
+        for (int x = 0; x < width; ++x) {  // Cairo: one native-endian 32-bit word per pixel, x R G B
+            row[3 * x] = static_cast<png_byte>(src[x] >> 16);
+            row[3 * x + 1] = static_cast<png_byte>(src[x] >> 8);
+            row[3 * x + 2] = static_cast<png_byte>(src[x]);
+        }
+        png_write_row(png, row.data());
+    }
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    return true;
 }
 
 void savePng(cairo_surface_t* surface, const std::filesystem::path& path) {
     cairo_surface_flush(surface);
     AtomicOfstream out(path);
-    const cairo_status_t status = cairo_surface_write_to_png_stream(surface, writeChunk, &out);
-    if (status != CAIRO_STATUS_SUCCESS)
-        throw IoError(path, std::string("PNG encoding failed: ") + cairo_status_to_string(status));
+    if (!encodePng(cairo_image_surface_get_data(surface), cairo_image_surface_get_width(surface),
+                   cairo_image_surface_get_height(surface), cairo_image_surface_get_stride(surface), out) ||
+        !out.stream())
+        throw IoError(path, "PNG encoding failed");
     out.commit();
 }
 
