@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <png.h>
 #include <unistd.h>
 
 #include "io/atomic_file.hpp"
@@ -322,6 +323,31 @@ TEST_F(IoPng, SceneHasSignatureAndWidth) {
 
     scene.hi = {0, 1};
     EXPECT_THROW(writePng(file, scene), std::invalid_argument);
+}
+
+// The pixels read back with libpng: the disk's colour at its centre, white ground in the corner.
+TEST_F(IoPng, PixelsReadBack) {
+    PngScene scene;
+    scene.lo = {0, 0};
+    scene.hi = {1, 1};
+    scene.widthPx = 200;
+    scene.disks = {{0.5, 0.5, 0.25, 0xcc3366}};
+    const fs::path file = dir_ / "pixels.png";
+    writePng(file, scene);
+    png_image image{};
+    image.version = PNG_IMAGE_VERSION;
+    ASSERT_TRUE(png_image_begin_read_from_file(&image, file.c_str())) << image.message;
+    image.format = PNG_FORMAT_RGB;
+    std::vector<unsigned char> px(PNG_IMAGE_SIZE(image));
+    ASSERT_TRUE(png_image_finish_read(&image, nullptr, px.data(), 0, nullptr)) << image.message;
+    ASSERT_EQ(image.width, 200u);
+    ASSERT_EQ(image.height, 200u);
+    auto at = [&](int x, int y) {
+        const unsigned char* q = &px[3 * (static_cast<std::size_t>(y) * 200 + x)];
+        return (std::uint32_t{q[0]} << 16) | (std::uint32_t{q[1]} << 8) | q[2];
+    };
+    EXPECT_EQ(at(100, 100), 0xcc3366u);
+    EXPECT_EQ(at(190, 190), 0xffffffu);
 }
 
 TEST_F(IoPng, LinePlot) {
