@@ -84,6 +84,7 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
     edm_->attachZones(link);
     tdm_ = std::make_unique<TdmEngine<D>>(w_, ts_);
     margin_ = std::max(ts_.skin, 0.1 * rmax);
+    rmax_ = rmax;
 
     // Energy baselines, then the first relabel (guard, stragglers).
     for (std::size_t i = 0; i < n; ++i) e0_ += particleEnergy(i);
@@ -166,8 +167,16 @@ template <int D>
 void HaetEngine<D>::bin(const Vec<D>& x, double r) {
     const std::uint32_t c = edm_->cellIndex(x);
     if (binHead_[c] == kNil) binCells_.push_back(c);
-    bins_.push_back(Binned{x, r, binHead_[c]});
-    binHead_[c] = static_cast<std::uint32_t>(bins_.size() - 1);
+    const auto b = static_cast<std::uint32_t>(bins_.size());
+    bins_.push_back(Binned{x, r, binHead_[c], kNil});
+    binHead_[c] = b;
+    if (near_.valid) {
+        const std::array<int, D> q = nearCoord(x);
+        std::size_t idx = 0;
+        for (int k = D - 1; k >= 0; --k) idx = idx * static_cast<std::size_t>(near_.n[k]) + static_cast<std::size_t>(q[k]);
+        bins_[b].nextNear = near_.head[idx];
+        near_.head[idx] = b;
+    }
 }
 
 template <int D>
@@ -184,18 +193,94 @@ void HaetEngine<D>::markAround(std::uint32_t cell, std::uint8_t level) {
 }
 
 template <int D>
+std::array<int, D> HaetEngine<D>::nearCoord(const Vec<D>& x) const {
+    std::array<int, D> c;
+    for (int k = 0; k < D; ++k) {
+        const int q = static_cast<int>(std::floor((x[k] - near_.lo[k]) * near_.invWidth[k]));
+        c[k] = w_.domain.periodic[k] ? ((q % near_.n[k]) + near_.n[k]) % near_.n[k] : std::clamp(q, 0, near_.n[k] - 1);
+    }
+    return c;
+}
+
+template <int D>
+void HaetEngine<D>::buildNearGrid() {
+    const double edge = 2 * rmax_ + margin_;
+    Vec<D> a = Vec<D>::filled(std::numeric_limits<double>::max()), b = Vec<D>::filled(-std::numeric_limits<double>::max());
+    for (const Binned& q : bins_)
+        for (int k = 0; k < D; ++k) {
+            a[k] = std::min(a[k], q.x[k]);
+            b[k] = std::max(b[k], q.x[k]);
+        }
+    // At most max(4096, 4 bins) cells: a few far-flung TDM particles give larger cells, not a huge grid.
+    const double maxCells = std::max(4096.0, 4.0 * static_cast<double>(bins_.size()));
+    for (double h = edge;; h *= 1.25) {
+        double total = 1;
+        for (int k = 0; k < D; ++k) {
+            if (w_.domain.periodic[k]) {
+                const double L = w_.domain.hi[k] - w_.domain.lo[k];
+                near_.n[k] = std::max(1, static_cast<int>(std::floor(L / h)));
+                near_.lo[k] = w_.domain.lo[k];
+                near_.invWidth[k] = near_.n[k] / L;
+            } else {
+                const double span = bins_.empty() ? 0.0 : b[k] - a[k];
+                near_.n[k] = std::max(1, static_cast<int>(std::ceil(span / h)));
+                near_.lo[k] = bins_.empty() ? 0.0 : a[k];
+                near_.invWidth[k] = 1 / h;
+            }
+            total *= near_.n[k];
+        }
+        if (total <= maxCells) break;
+    }
+    std::size_t total = 1;
+    for (int k = 0; k < D; ++k) total *= static_cast<std::size_t>(near_.n[k]);
+    near_.head.assign(total, kNil);
+    near_.valid = true;
+    for (std::uint32_t i = 0; i < bins_.size(); ++i) {
+        const std::array<int, D> q = nearCoord(bins_[i].x);
+        std::size_t idx = 0;
+        for (int k = D - 1; k >= 0; --k) idx = idx * static_cast<std::size_t>(near_.n[k]) + static_cast<std::size_t>(q[k]);
+        bins_[i].nextNear = near_.head[idx];
+        near_.head[idx] = i;
+    }
+}
+
+// Positions outside the near grid on an open axis fall into its outer cells, bins and queries alike: clamping
+// never separates two points less than a cell apart by more than one cell.
+template <int D>
 double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r) const {
     double gap = kNever;
+    if (!near_.valid) return gap;
     const Vec<D> L = w_.domain.length();
-    edm_->forEachNeighbourCell(edm_->cellIndex(x), [&](std::uint32_t idx) {
-        for (std::uint32_t b = binHead_[idx]; b != kNil; b = bins_[b].next) {
+    const std::array<int, D> c = nearCoord(x);
+    constexpr int m = D == 2 ? 9 : 27;
+    for (int code = 0; code < m; ++code) {
+        std::size_t idx = 0;
+        bool inside = true;
+        int t = code;
+        std::array<int, D> cc;
+        for (int k = 0; k < D; ++k) {
+            int ck = c[k] + t % 3 - 1;
+            t /= 3;
+            if (ck < 0 || ck >= near_.n[k]) {
+                if (!w_.domain.periodic[k]) {
+                    inside = false;
+                    break;
+                }
+                ck = (ck + near_.n[k]) % near_.n[k];
+            }
+            cc[k] = ck;
+        }
+        if (!inside) continue;
+        // A periodic axis of one or two cells visits a cell more than once: harmless for a minimum.
+        for (int k = D - 1; k >= 0; --k) idx = idx * static_cast<std::size_t>(near_.n[k]) + static_cast<std::size_t>(cc[k]);
+        for (std::uint32_t b = near_.head[idx]; b != kNil; b = bins_[b].nextNear) {
             Vec<D> d = x - bins_[b].x;
             for (int k = 0; k < D; ++k)
                 if (w_.domain.periodic[k]) d[k] -= std::nearbyint(d[k] / L[k]) * L[k];
             const double reach = r + bins_[b].r + margin_, d2 = norm2(d);
             if (d2 < reach * reach && d2 > 0) gap = std::min(gap, std::sqrt(d2) - r - bins_[b].r);
         }
-    });
+    }
     return gap;
 }
 
@@ -272,6 +357,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
         binCells_.pop_back();
     }
     bins_.clear();
+    near_.valid = false;
     std::vector<std::uint32_t> candidates;
     for (std::size_t i = 0; i < nT; ++i) {
         const std::uint64_t last = due ? lastTdmStep_[zoneOf[i]] : steps_;
@@ -283,6 +369,8 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
         else
             bin(p.x[i], p.radius[i]);
     }
+
+    buildNearGrid();
 
     // The new guard: level 2 in time-driven zones, level 1 around the staying TDM particles.
     newList_.clear();

@@ -89,8 +89,21 @@ private:
     struct Binned {  // a TDM particle as seen by the guard: position at the last relabel, radius, next in cell
         Vec<D> x;
         double r;
-        std::uint32_t next;
+        std::uint32_t next;      // in its event-grid cell
+        std::uint32_t nextNear;  // in its cell of the near grid
     };
+    /// A grid of edge >= largest diameter + margin over the binned TDM particles, for gapToTdm: the event grid's
+    /// cells may be much larger. Open axes span the binned particles (others fall into the outer cells),
+    /// periodic ones the box.
+    struct NearGrid {
+        std::array<int, D> n{};
+        Vec<D> lo, invWidth;
+        std::vector<std::uint32_t> head;
+        bool valid = false;
+    };
+    /// The near grid over the current bins, with every bin in it; later bins go in as they come.
+    void buildNearGrid();
+    std::array<int, D> nearCoord(const Vec<D>& x) const;
     /// The guard and bins from the current TDM positions; on due steps also the zone labels and the mode changes
     /// they imply (urgent hand-overs always).
     void relabel(std::vector<std::uint32_t> arrivals, bool due);
@@ -120,6 +133,8 @@ private:
     std::vector<std::uint32_t> guardList_, newList_;
     std::vector<std::uint32_t> binHead_, binCells_;
     std::vector<Binned> bins_;
+    NearGrid near_;
+    double rmax_ = 0;
     std::vector<std::uint32_t> watch_;               // event-driven particles in guard cells (World indices)
     std::array<std::vector<std::uint32_t>, D> zoneCellBegin_;  // per axis and zone coordinate: first cell coordinate
     std::vector<std::uint64_t> lastTdmStep_;  // per zone: last step it was time-driven
