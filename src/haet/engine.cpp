@@ -171,9 +171,7 @@ void HaetEngine<D>::bin(const Vec<D>& x, double r) {
     bins_.push_back(Binned{x, r, binHead_[c], kNil});
     binHead_[c] = b;
     if (near_.valid) {
-        const std::array<int, D> q = nearCoord(x);
-        std::size_t idx = 0;
-        for (int k = D - 1; k >= 0; --k) idx = idx * static_cast<std::size_t>(near_.n[k]) + static_cast<std::size_t>(q[k]);
+        const std::size_t idx = nearIndex(nearCoord(x));
         bins_[b].nextNear = near_.head[idx];
         near_.head[idx] = b;
     }
@@ -200,6 +198,13 @@ std::array<int, D> HaetEngine<D>::nearCoord(const Vec<D>& x) const {
         c[k] = w_.domain.periodic[k] ? ((q % near_.n[k]) + near_.n[k]) % near_.n[k] : std::clamp(q, 0, near_.n[k] - 1);
     }
     return c;
+}
+
+template <int D>
+std::size_t HaetEngine<D>::nearIndex(const std::array<int, D>& c) const {
+    std::size_t idx = 0;
+    for (int k = D - 1; k >= 0; --k) idx = idx * static_cast<std::size_t>(near_.n[k]) + static_cast<std::size_t>(c[k]);
+    return idx;
 }
 
 template <int D>
@@ -236,9 +241,7 @@ void HaetEngine<D>::buildNearGrid() {
     near_.head.assign(total, kNil);
     near_.valid = true;
     for (std::uint32_t i = 0; i < bins_.size(); ++i) {
-        const std::array<int, D> q = nearCoord(bins_[i].x);
-        std::size_t idx = 0;
-        for (int k = D - 1; k >= 0; --k) idx = idx * static_cast<std::size_t>(near_.n[k]) + static_cast<std::size_t>(q[k]);
+        const std::size_t idx = nearIndex(nearCoord(bins_[i].x));
         bins_[i].nextNear = near_.head[idx];
         near_.head[idx] = i;
     }
@@ -254,7 +257,6 @@ double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r) const {
     const std::array<int, D> c = nearCoord(x);
     constexpr int m = D == 2 ? 9 : 27;
     for (int code = 0; code < m; ++code) {
-        std::size_t idx = 0;
         bool inside = true;
         int t = code;
         std::array<int, D> cc;
@@ -272,8 +274,7 @@ double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r) const {
         }
         if (!inside) continue;
         // A periodic axis of one or two cells visits a cell more than once: harmless for a minimum.
-        for (int k = D - 1; k >= 0; --k) idx = idx * static_cast<std::size_t>(near_.n[k]) + static_cast<std::size_t>(cc[k]);
-        for (std::uint32_t b = near_.head[idx]; b != kNil; b = bins_[b].nextNear) {
+        for (std::uint32_t b = near_.head[nearIndex(cc)]; b != kNil; b = bins_[b].nextNear) {
             Vec<D> d = x - bins_[b].x;
             for (int k = 0; k < D; ++k)
                 if (w_.domain.periodic[k]) d[k] -= std::nearbyint(d[k] / L[k]) * L[k];

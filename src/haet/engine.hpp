@@ -104,6 +104,7 @@ private:
     /// The near grid over the current bins, with every bin in it; later bins go in as they come.
     void buildNearGrid();
     std::array<int, D> nearCoord(const Vec<D>& x) const;
+    std::size_t nearIndex(const std::array<int, D>& c) const;
     /// The guard and bins from the current TDM positions; on due steps also the zone labels and the mode changes
     /// they imply (urgent hand-overs always).
     void relabel(std::vector<std::uint32_t> arrivals, bool due);
