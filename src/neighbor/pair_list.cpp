@@ -58,9 +58,7 @@ struct Grid {
 /// The cell of x and its neighbours, de-duplicated (a periodic axis with fewer than 3 cells maps offsets
 /// together), in increasing order. Returns their number (at most 3^D).
 template <int D>
-int neighbourCells(const Grid<D>& g, const Domain<D>& dom, const Vec<D>& x, int* cells) {
-    std::array<int, D> c;
-    for (int k = 0; k < D; ++k) c[k] = g.coord(x, k);
+int neighbourCellsOf(const Grid<D>& g, const Domain<D>& dom, const std::array<int, D>& c, int* cells) {
     int nc = 0;
     constexpr int m = (D == 2) ? 9 : 27;
     for (int code = 0; code < m; ++code) {
@@ -81,6 +79,77 @@ int neighbourCells(const Grid<D>& g, const Domain<D>& dom, const Vec<D>& x, int*
     std::sort(cells, cells + nc);
     return static_cast<int>(std::unique(cells, cells + nc) - cells);
 }
+
+template <int D>
+int neighbourCells(const Grid<D>& g, const Domain<D>& dom, const Vec<D>& x, int* cells) {
+    std::array<int, D> c;
+    for (int k = 0; k < D; ++k) c[k] = g.coord(x, k);
+    return neighbourCellsOf<D>(g, dom, c, cells);
+}
+
+/// The neighbour cells of every occupied cell, each with the image-shift code of its particles: cell c's are
+/// entries [first[c], first[c] + count[c]). When every periodic axis has at least 3 cells (each no narrower
+/// than the cutoff), a neighbour cell reached across a periodic face holds only images shifted by one box
+/// length, and the code is exact. Otherwise offsets fold onto the same cell (neighbourCells de-duplicates them)
+/// and the code is kAnyShift: the pair test finds the minimum image itself.
+template <int D>
+struct CellNeighbours {
+    static constexpr std::uint8_t kAnyShift = 0xFF;
+    struct Entry {
+        int cell;
+        std::uint8_t code;
+    };
+    std::vector<std::uint32_t> first;
+    std::vector<std::uint8_t> count;
+    std::vector<Entry> list;
+
+    CellNeighbours(const Grid<D>& g, const Domain<D>& dom, const std::vector<std::uint32_t>& cellStart) {
+        bool exact = true;
+        for (int k = 0; k < D; ++k) exact = exact && (!dom.periodic[k] || g.n[k] >= 3);
+        first.assign(static_cast<std::size_t>(g.total), 0);
+        count.assign(static_cast<std::size_t>(g.total), 0);
+        constexpr int m = (D == 2) ? 9 : 27;
+        for (int c = 0; c < g.total; ++c) {
+            if (cellStart[c] == cellStart[c + 1]) continue;
+            std::array<int, D> cc;
+            int t = c;
+            for (int k = 0; k < D; ++k) {  // Grid::index is x fastest
+                cc[k] = t % g.n[k];
+                t /= g.n[k];
+            }
+            first[c] = static_cast<std::uint32_t>(list.size());
+            if (!exact) {
+                int cells[27];
+                const int nc = neighbourCellsOf<D>(g, dom, cc, cells);
+                for (int q = 0; q < nc; ++q) list.push_back({cells[q], kAnyShift});
+                count[c] = static_cast<std::uint8_t>(nc);
+                continue;
+            }
+            for (int offset = 0; offset < m; ++offset) {
+                std::array<int, D> nc;
+                int u = offset, code = 0, mul = 1;
+                bool inside = true;
+                for (int k = 0; k < D && inside; ++k) {
+                    nc[k] = cc[k] + u % 3 - 1;
+                    u /= 3;
+                    int shift = 0;  // d = x_i - x_j + shift L: +1 for an image to the left of the box
+                    if (nc[k] < 0) {
+                        nc[k] += g.n[k];
+                        shift = 1;
+                    } else if (nc[k] >= g.n[k]) {
+                        nc[k] -= g.n[k];
+                        shift = -1;
+                    }
+                    inside = shift == 0 || dom.periodic[k];
+                    code += (shift + 1) * mul;
+                    mul *= 3;
+                }
+                if (inside) list.push_back({g.index(nc), static_cast<std::uint8_t>(code)});
+            }
+            count[c] = static_cast<std::uint8_t>(list.size() - first[c]);
+        }
+    }
+};
 
 /// Particles sorted by cell: cellStart (size total+1) and the particle indices in cell order.
 template <int D>
@@ -233,15 +302,29 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
     sortIntoCells(p, g, cellStart, members, cellOf);
     out.shiftVec = makeShiftVectors(dom);
 
+    const CellNeighbours<D> nb(g, dom, cellStart);
+    // A cell's members are in increasing index order: the partners j > i of each cell start after i.
     auto candidates = [&](std::size_t i, auto&& add) {
-        int cells[27];
-        const int nc = neighbourCells(g, dom, p.x[i], cells);
-        for (int q = 0; q < nc; ++q) {
-            for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) {
-                const std::uint32_t j = members[a];
-                if (j <= i) continue;
-                std::uint8_t code;
-                if (testPair(p, dom, s, static_cast<std::uint32_t>(i), j, code)) add(j, code);
+        const auto* cells = nb.list.data() + nb.first[cellOf[i]];
+        const std::uint32_t* m = members.data();
+        const bool frozen = s.excludeFrozenPairs && (p.flags[i] & kFrozen);
+        for (int q = 0, nc = nb.count[cellOf[i]]; q < nc; ++q) {
+            const std::uint32_t* end = m + cellStart[cells[q].cell + 1];
+            const std::uint32_t* a = std::upper_bound(m + cellStart[cells[q].cell], end, static_cast<std::uint32_t>(i));
+            const std::uint8_t code = cells[q].code;
+            if (code == CellNeighbours<D>::kAnyShift) {
+                for (; a != end; ++a) {
+                    std::uint8_t found;
+                    if (testPair(p, dom, s, static_cast<std::uint32_t>(i), *a, found)) add(*a, found);
+                }
+                continue;
+            }
+            const Vec<D> xi = p.x[i] + out.shiftVec[code];
+            for (; a != end; ++a) {
+                const std::uint32_t j = *a;
+                if (frozen && (p.flags[j] & kFrozen)) continue;
+                const double cut = p.radius[i] + p.radius[j] + s.skin;
+                if (norm2(xi - p.x[j]) < cut * cut) add(j, code);
             }
         }
     };
