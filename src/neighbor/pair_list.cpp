@@ -192,6 +192,7 @@ void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
     }
     out.firstT.clear();
     out.pairT.clear();
+    out.split = ThreadSplit{};
 }
 
 }  // namespace
@@ -258,6 +259,49 @@ void buildTransposedIndex(PairList<D>& list) {
     list.pairT.resize(np);
     std::vector<std::uint32_t> fill(list.firstT.begin(), list.firstT.end() - 1);
     for (std::size_t k = 0; k < np; ++k) list.pairT[fill[list.partner[k]]++] = static_cast<std::uint32_t>(k);
+}
+
+template <int D>
+void buildThreadSplit(PairList<D>& list, int ranges) {
+    ThreadSplit& s = list.split;
+    const std::size_t n = list.first.size() - 1;
+    const std::size_t nr = static_cast<std::size_t>(std::max(ranges, 1));
+    // Work of particles [0, i): its pair slots, and per particle about as much again as two slots (the
+    // particle's own loads, its finishing and its integrator step).
+    auto work = [&](std::size_t i) { return std::uint64_t{list.first[i]} + 2 * std::uint64_t{i}; };
+    s.start.assign(nr + 1, static_cast<std::uint32_t>(n));
+    s.start[0] = 0;
+    for (std::size_t r = 1; r < nr; ++r) {
+        const std::uint64_t goal = work(n) * r / nr;
+        std::size_t lo = s.start[r - 1], hi = n;  // first i with work(i) >= goal
+        while (lo < hi) {
+            const std::size_t mid = (lo + hi) / 2;
+            if (work(mid) < goal) lo = mid + 1;
+            else hi = mid;
+        }
+        s.start[r] = static_cast<std::uint32_t>(lo);
+    }
+    s.crossSlot.clear();
+    s.crossOwner.clear();
+    s.crossIn.clear();
+    s.crossFirst.assign(nr + 1, 0);
+    for (std::size_t r = 0; r < nr; ++r) {
+        s.crossFirst[r] = static_cast<std::uint32_t>(s.crossSlot.size());
+        for (std::uint32_t i = s.start[r]; i < s.start[r + 1]; ++i)
+            for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
+                if (list.partner[k] < s.start[r + 1]) continue;
+                s.crossIn.push_back(std::uint64_t{list.partner[k]} << 32 | s.crossSlot.size());
+                s.crossSlot.push_back(k);
+                s.crossOwner.push_back(i);
+            }
+    }
+    s.crossFirst[nr] = static_cast<std::uint32_t>(s.crossSlot.size());
+    std::sort(s.crossIn.begin(), s.crossIn.end());
+    s.crossInFirst.assign(nr + 1, 0);
+    for (std::size_t r = 0; r <= nr; ++r)
+        s.crossInFirst[r] = static_cast<std::uint32_t>(
+            std::lower_bound(s.crossIn.begin(), s.crossIn.end(), std::uint64_t{s.start[r]} << 32) - s.crossIn.begin());
+    s.crossInFirst[nr] = static_cast<std::uint32_t>(s.crossIn.size());
 }
 
 template <int D>
@@ -375,8 +419,9 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 std::swap(list.history[q - 1], list.history[q]);
             }
     list.shiftVec = makeShiftVectors(dom);
-    list.firstT.clear();  // the transposed index is built by the threaded force loop when it needs it
+    list.firstT.clear();  // the transposed index and the thread split are built by the force loop when needed
     list.pairT.clear();
+    list.split = ThreadSplit{};
 }
 
 template <int D>
@@ -413,6 +458,7 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     }
     list.firstT.clear();
     list.pairT.clear();
+    list.split = ThreadSplit{};
 }
 
 #define HAET_INSTANTIATE(D)                                                                                     \
@@ -420,6 +466,7 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
                                    const PairList<D>&, PairList<D>&);                                           \
     template void buildAllPairs<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, PairList<D>&); \
     template void buildTransposedIndex<D>(PairList<D>&);                                                        \
+    template void buildThreadSplit<D>(PairList<D>&, int);                                                       \
     template void wrapPositions<D>(Particles<D>&, const Domain<D>&);                                            \
     template std::vector<std::uint32_t> spatialOrder<D>(const Particles<D>&, const Domain<D>&, double);         \
     template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);                        \

@@ -66,7 +66,7 @@ void TdmEngine<D>::computeForces(bool correct) {
             forces(verlet_->corrector(w_.particles, s_.dt));
             corrected = true;
         } else {
-            forces([](std::size_t) {});
+            forces([](std::size_t, const Vec<D>&, const Ang<D>&) {});
         }
     };
     auto withTangential = [&](auto normal) {
