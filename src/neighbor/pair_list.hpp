@@ -60,6 +60,11 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
 template <int D>
 void buildTransposedIndex(PairList<D>& list);
 
+/// Keeps only the pairs whose tangential history is not zero (the contacts), in order, in arrays of their size:
+/// all that a rebuild carries over from the old list.
+template <int D>
+void keepTouchingPairs(PairList<D>& list);
+
 /// Cuts particles [0, n) into `ranges` contiguous ranges of about equal work (pair slots plus particles) and
 /// lists the pairs that cross from one range into a later one (list.split).
 template <int D>

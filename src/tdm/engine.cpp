@@ -98,11 +98,10 @@ void TdmEngine<D>::rebuild(bool sort) {
         if (integ_ && steps_ > 0) integ_->permute(order);
         if (!motion_.v.empty()) {
             auto mv = motion_.v;
+            for (std::size_t k = 0; k < n; ++k) motion_.v[k] = mv[order[k]];
+            std::vector<Vec<D>>().swap(mv);
             auto mw = motion_.w;
-            for (std::size_t k = 0; k < n; ++k) {
-                motion_.v[k] = mv[order[k]];
-                motion_.w[k] = mw[order[k]];
-            }
+            for (std::size_t k = 0; k < n; ++k) motion_.w[k] = mw[order[k]];
         }
         const std::size_t nw = w_.walls.size();
         if (nw > 0) {
@@ -112,6 +111,10 @@ void TdmEngine<D>::rebuild(bool sort) {
             wallHistory_.swap(wh);
         }
         lastSort_ = steps_;
+    } else {
+        // Only the contacts' springs carry over into the new list: the old list shrinks to them before the new
+        // one is built, so the two lists never coexist in full (permutePairList has done the same after a sort).
+        keepTouchingPairs(pairs_);
     }
     PairList<D> fresh;
     buildPairList(p, w_.domain, NeighborSettings{s_.skin, true}, pairs_, fresh);
