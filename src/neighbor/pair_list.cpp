@@ -480,6 +480,9 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     struct Entry { std::uint32_t i, j; Vec<D> h; };
     std::vector<Entry> kept;
     if (!list.history.empty()) {
+        std::size_t touching = 0;
+        for (const Vec<D>& h : list.history) touching += norm2(h) != 0;
+        kept.reserve(touching);
         for (std::size_t i = 0; i < nOld; ++i)
             for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
                 if (norm2(list.history[k]) == 0) continue;

@@ -89,6 +89,9 @@ void TdmEngine<D>::rebuild(bool sort) {
     Particles<D>& p = w_.particles;
     const std::size_t n = p.tdmCount();
     wrapPositions(p, w_.domain);
+    // Only the contacts' springs carry over into the new list: the old list shrinks to them first, so that it
+    // never coexists in full with the new one, nor with the copies a sort makes.
+    keepTouchingPairs(pairs_);
     if (sort) {
         double rmax = 0;
         for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
@@ -111,10 +114,6 @@ void TdmEngine<D>::rebuild(bool sort) {
             wallHistory_.swap(wh);
         }
         lastSort_ = steps_;
-    } else {
-        // Only the contacts' springs carry over into the new list: the old list shrinks to them before the new
-        // one is built, so the two lists never coexist in full (permutePairList has done the same after a sort).
-        keepTouchingPairs(pairs_);
     }
     PairList<D> fresh;
     buildPairList(p, w_.domain, NeighborSettings{s_.skin, true}, pairs_, fresh);
