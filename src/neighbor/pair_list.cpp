@@ -209,36 +209,55 @@ inline bool testPair(const Particles<D>& p, const Domain<D>& dom, const Neighbor
 
 /// Lists for each particle i the pairs that candidates(i, add) reports (add(j, code) for each partner j > i and
 /// its image-shift code) into out's first/partner/shift, each particle's sorted by j. Threads take contiguous
-/// particle ranges into flat buffers of their own, copied into place in order: no per-particle vectors.
+/// particle ranges into partner and shift arrays of their own (5 bytes a pair), which one thread hands over
+/// as they are and several copy into place in order: no per-particle vectors.
 template <int D, class Candidates>
 void collectPairs(std::size_t n, const Candidates& candidates, PairList<D>& out) {
     out.first.assign(n + 1, 0);
-    std::vector<std::vector<std::uint64_t>> bufs(static_cast<std::size_t>(omp_get_max_threads()));
+    struct Part {
+        std::vector<std::uint32_t> partner;
+        std::vector<std::uint8_t> shift;
+    };
+    std::vector<Part> parts(static_cast<std::size_t>(omp_get_max_threads()));
+    std::size_t used = 1;
 #pragma omp parallel if (n >= kParallelMin)
     {
         const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
         const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
         const std::size_t i0 = n * t / nt, i1 = n * (t + 1) / nt;
-        std::vector<std::uint64_t>& buf = bufs[t];  // partner << 8 | code: sorting sorts by partner
+        Part& part = parts[t];
+        std::vector<std::uint64_t> row;  // partner << 8 | code: sorting sorts by partner
         for (std::size_t i = i0; i < i1; ++i) {
-            const std::size_t start = buf.size();
-            candidates(i, [&](std::uint32_t j, std::uint8_t code) { buf.push_back(std::uint64_t{j} << 8 | code); });
-            std::sort(buf.begin() + static_cast<std::ptrdiff_t>(start), buf.end());
-            out.first[i + 1] = static_cast<std::uint32_t>(buf.size() - start);
+            row.clear();
+            candidates(i, [&](std::uint32_t j, std::uint8_t code) { row.push_back(std::uint64_t{j} << 8 | code); });
+            std::sort(row.begin(), row.end());
+            for (const std::uint64_t c : row) {
+                part.partner.push_back(static_cast<std::uint32_t>(c >> 8));
+                part.shift.push_back(static_cast<std::uint8_t>(c & 0xFF));
+            }
+            out.first[i + 1] = static_cast<std::uint32_t>(row.size());
         }
-#pragma omp barrier
 #pragma omp single
-        {
-            for (std::size_t i = 0; i < n; ++i) out.first[i + 1] += out.first[i];
-            out.partner.resize(out.first[n]);
-            out.shift.resize(out.first[n]);
+        used = nt;
+    }
+    for (std::size_t i = 0; i < n; ++i) out.first[i + 1] += out.first[i];
+    if (used == 1) {
+        out.partner.swap(parts[0].partner);
+        out.shift.swap(parts[0].shift);
+        if (out.partner.capacity() > out.partner.size() + out.partner.size() / 4) {  // growth slack
+            out.partner.shrink_to_fit();
+            out.shift.shrink_to_fit();
         }
-        std::uint32_t o = out.first[i0];
-        for (const std::uint64_t c : buf) {
-            out.partner[o] = static_cast<std::uint32_t>(c >> 8);
-            out.shift[o] = static_cast<std::uint8_t>(c & 0xFF);
-            ++o;
-        }
+        return;
+    }
+    out.partner.resize(out.first[n]);
+    out.shift.resize(out.first[n]);
+    std::size_t o = 0;
+    for (std::size_t t = 0; t < used; ++t) {
+        std::copy(parts[t].partner.begin(), parts[t].partner.end(), out.partner.begin() + static_cast<std::ptrdiff_t>(o));
+        std::copy(parts[t].shift.begin(), parts[t].shift.end(), out.shift.begin() + static_cast<std::ptrdiff_t>(o));
+        o += parts[t].partner.size();
+        parts[t] = Part{};
     }
 }
 
@@ -261,6 +280,7 @@ void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
     }
     out.firstT.clear();
     out.pairT.clear();
+    out.split = ThreadSplit{};
 }
 
 }  // namespace
@@ -341,6 +361,75 @@ void buildTransposedIndex(PairList<D>& list) {
     list.pairT.resize(np);
     std::vector<std::uint32_t> fill(list.firstT.begin(), list.firstT.end() - 1);
     for (std::size_t k = 0; k < np; ++k) list.pairT[fill[list.partner[k]]++] = static_cast<std::uint32_t>(k);
+}
+
+template <int D>
+void keepTouchingPairs(PairList<D>& list) {
+    const std::size_t n = list.first.empty() ? 0 : list.first.size() - 1;
+    std::uint32_t o = 0, k = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t end = list.first[i + 1];
+        list.first[i] = o;
+        for (; k < end; ++k) {
+            if (list.history.empty() || norm2(list.history[k]) == 0) continue;
+            list.partner[o] = list.partner[k];
+            list.shift[o] = list.shift[k];
+            list.history[o] = list.history[k];
+            ++o;
+        }
+    }
+    if (n > 0) list.first[n] = o;
+    // New arrays of the kept size: resize alone would keep the capacity.
+    list.partner = std::vector<std::uint32_t>(list.partner.begin(), list.partner.begin() + o);
+    list.shift = std::vector<std::uint8_t>(list.shift.begin(), list.shift.begin() + o);
+    list.history = list.history.empty() ? std::vector<Vec<D>>{}
+                                        : std::vector<Vec<D>>(list.history.begin(), list.history.begin() + o);
+    std::vector<std::uint32_t>().swap(list.firstT);
+    std::vector<std::uint32_t>().swap(list.pairT);
+    list.split = ThreadSplit{};
+}
+
+template <int D>
+void buildThreadSplit(PairList<D>& list, int ranges) {
+    ThreadSplit& s = list.split;
+    const std::size_t n = list.first.size() - 1;
+    const std::size_t nr = static_cast<std::size_t>(std::max(ranges, 1));
+    // Work of particles [0, i): its pair slots, and per particle about as much again as two slots (the
+    // particle's own loads, its finishing and its integrator step).
+    auto work = [&](std::size_t i) { return std::uint64_t{list.first[i]} + 2 * std::uint64_t{i}; };
+    s.start.assign(nr + 1, static_cast<std::uint32_t>(n));
+    s.start[0] = 0;
+    for (std::size_t r = 1; r < nr; ++r) {
+        const std::uint64_t goal = work(n) * r / nr;
+        std::size_t lo = s.start[r - 1], hi = n;  // first i with work(i) >= goal
+        while (lo < hi) {
+            const std::size_t mid = (lo + hi) / 2;
+            if (work(mid) < goal) lo = mid + 1;
+            else hi = mid;
+        }
+        s.start[r] = static_cast<std::uint32_t>(lo);
+    }
+    s.crossSlot.clear();
+    s.crossOwner.clear();
+    s.crossIn.clear();
+    s.crossFirst.assign(nr + 1, 0);
+    for (std::size_t r = 0; r < nr; ++r) {
+        s.crossFirst[r] = static_cast<std::uint32_t>(s.crossSlot.size());
+        for (std::uint32_t i = s.start[r]; i < s.start[r + 1]; ++i)
+            for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
+                if (list.partner[k] < s.start[r + 1]) continue;
+                s.crossIn.push_back(std::uint64_t{list.partner[k]} << 32 | s.crossSlot.size());
+                s.crossSlot.push_back(k);
+                s.crossOwner.push_back(i);
+            }
+    }
+    s.crossFirst[nr] = static_cast<std::uint32_t>(s.crossSlot.size());
+    std::sort(s.crossIn.begin(), s.crossIn.end());
+    s.crossInFirst.assign(nr + 1, 0);
+    for (std::size_t r = 0; r <= nr; ++r)
+        s.crossInFirst[r] = static_cast<std::uint32_t>(
+            std::lower_bound(s.crossIn.begin(), s.crossIn.end(), std::uint64_t{s.start[r]} << 32) - s.crossIn.begin());
+    s.crossInFirst[nr] = static_cast<std::uint32_t>(s.crossIn.size());
 }
 
 template <int D>
@@ -466,8 +555,9 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 std::swap(list.history[q - 1], list.history[q]);
             }
     list.shiftVec = makeShiftVectors(dom);
-    list.firstT.clear();  // the transposed index is built by the threaded force loop when it needs it
+    list.firstT.clear();  // the transposed index and the thread split are built by the force loop when needed
     list.pairT.clear();
+    list.split = ThreadSplit{};
 }
 
 template <int D>
@@ -481,6 +571,9 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     struct Entry { std::uint32_t i, j; Vec<D> h; };
     std::vector<Entry> kept;
     if (!list.history.empty()) {
+        std::size_t touching = 0;
+        for (const Vec<D>& h : list.history) touching += norm2(h) != 0;
+        kept.reserve(touching);
         for (std::size_t i = 0; i < nOld; ++i)
             for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
                 if (norm2(list.history[k]) == 0) continue;
@@ -495,15 +588,16 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     list.first.assign(n + 1, 0);
     for (const auto& e : kept) ++list.first[e.i + 1];
     for (std::size_t i = 0; i < n; ++i) list.first[i + 1] += list.first[i];
-    list.partner.resize(kept.size());
-    list.history.resize(kept.size());
-    list.shift.assign(kept.size(), PairList<D>::kNoShift);
+    list.partner = std::vector<std::uint32_t>(kept.size());  // new arrays: resize alone would keep the capacity
+    list.history = std::vector<Vec<D>>(kept.size());
+    list.shift = std::vector<std::uint8_t>(kept.size(), PairList<D>::kNoShift);
     for (std::size_t k = 0; k < kept.size(); ++k) {
         list.partner[k] = kept[k].j;
         list.history[k] = kept[k].h;
     }
     list.firstT.clear();
     list.pairT.clear();
+    list.split = ThreadSplit{};
 }
 
 #define HAET_INSTANTIATE(D)                                                                                     \
@@ -511,6 +605,8 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
                                    const PairList<D>&, PairList<D>&);                                           \
     template void buildAllPairs<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, PairList<D>&); \
     template void buildTransposedIndex<D>(PairList<D>&);                                                        \
+    template void buildThreadSplit<D>(PairList<D>&, int);                                                       \
+    template void keepTouchingPairs<D>(PairList<D>&);                                                           \
     template void wrapPositions<D>(Particles<D>&, const Domain<D>&);                                            \
     template std::vector<std::uint32_t> spatialOrder<D>(const Particles<D>&, const Domain<D>&, double);         \
     template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);                        \

@@ -13,6 +13,20 @@
 
 namespace haet {
 
+/// The threaded force loop's split of the particles (tdm/forces.hpp): one contiguous range per thread, and the
+/// "cross" pairs, whose partner lies in a later range than their owner. Only the cross pairs need evaluating
+/// before the ranges run side by side; every other pair lies inside one range.
+struct ThreadSplit {
+    std::vector<std::uint32_t> start;         ///< range r is particles [start[r], start[r+1])
+    std::vector<std::uint32_t> crossSlot;     ///< pair slot of each cross pair, in pair order
+    std::vector<std::uint32_t> crossOwner;    ///< owner i of each cross pair
+    std::vector<std::uint32_t> crossFirst;    ///< range r owns cross pairs [crossFirst[r], crossFirst[r+1])
+    std::vector<std::uint64_t> crossIn;       ///< partner << 32 | cross pair, sorted: the cross pairs by partner
+    std::vector<std::uint32_t> crossInFirst;  ///< range r's partners: crossIn[crossInFirst[r], crossInFirst[r+1])
+
+    std::size_t ranges() const { return start.empty() ? 0 : start.size() - 1; }
+};
+
 template <int D>
 struct PairList {
     std::vector<std::uint32_t> first;   ///< CSR offsets, size n+1
@@ -24,6 +38,8 @@ struct PairList {
     // force loop needs it: buildTransposedIndex() makes it, a build leaves it empty.
     std::vector<std::uint32_t> firstT;
     std::vector<std::uint32_t> pairT;
+    // The threaded disk force loop's split: buildThreadSplit() makes it, a build leaves it empty.
+    ThreadSplit split;
 
     std::size_t size() const { return partner.size(); }
     static constexpr int kNoShift = (D == 2) ? 4 : 13;
@@ -43,6 +59,16 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
 /// Builds the transposed index (firstT, pairT) of a built list.
 template <int D>
 void buildTransposedIndex(PairList<D>& list);
+
+/// Keeps only the pairs whose tangential history is not zero (the contacts), in order, in arrays of their size:
+/// all that a rebuild carries over from the old list.
+template <int D>
+void keepTouchingPairs(PairList<D>& list);
+
+/// Cuts particles [0, n) into `ranges` contiguous ranges of about equal work (pair slots plus particles) and
+/// lists the pairs that cross from one range into a later one (list.split).
+template <int D>
+void buildThreadSplit(PairList<D>& list, int ranges);
 
 /// The reference twin: all N(N-1)/2 pairs tested directly. Same output format (no history transfer).
 template <int D>

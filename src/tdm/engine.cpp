@@ -66,7 +66,7 @@ void TdmEngine<D>::computeForces(bool correct) {
             forces(verlet_->corrector(w_.particles, s_.dt));
             corrected = true;
         } else {
-            forces([](std::size_t) {});
+            forces([](std::size_t, const Vec<D>&, const Ang<D>&) {});
         }
     };
     auto withTangential = [&](auto normal) {
@@ -89,6 +89,9 @@ void TdmEngine<D>::rebuild(bool sort) {
     Particles<D>& p = w_.particles;
     const std::size_t n = p.tdmCount();
     wrapPositions(p, w_.domain);
+    // Only the contacts' springs carry over into the new list: the old list shrinks to them first, so that it
+    // never coexists in full with the new one, nor with the copies a sort makes.
+    keepTouchingPairs(pairs_);
     if (sort) {
         double rmax = 0;
         for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
@@ -98,11 +101,10 @@ void TdmEngine<D>::rebuild(bool sort) {
         if (integ_ && steps_ > 0) integ_->permute(order);
         if (!motion_.v.empty()) {
             auto mv = motion_.v;
+            for (std::size_t k = 0; k < n; ++k) motion_.v[k] = mv[order[k]];
+            std::vector<Vec<D>>().swap(mv);
             auto mw = motion_.w;
-            for (std::size_t k = 0; k < n; ++k) {
-                motion_.v[k] = mv[order[k]];
-                motion_.w[k] = mw[order[k]];
-            }
+            for (std::size_t k = 0; k < n; ++k) motion_.w[k] = mw[order[k]];
         }
         const std::size_t nw = w_.walls.size();
         if (nw > 0) {

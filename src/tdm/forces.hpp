@@ -3,14 +3,17 @@
 //
 // Results do not depend on the thread count: every particle sums its contributions in one fixed order —
 // gravity, then the pairs in which it is the partner j (by increasing pair index), then its own pairs, then its
-// wall contacts. Two ways produce that order:
-//  - serial: one pass over particles in index order that adds each pair force to both particles (scatter);
-//  - threaded: pass 1 evaluates every pair once into its own slot, pass 2 gathers per particle through the
-//    transposed index. Same additions in the same order, so the same bits.
-// Once its sums are complete a particle is finished at once (finishParticle: walls, torque, statistics, the
-// caller's per-particle step such as the Verlet corrector), so a step reads the particles once instead of once
-// per pass. In the serial path particle i's sums are complete right after its own pairs: its partners j > i come
-// later and never see it again, and the pairs where it is the partner came before.
+// wall contacts. One pass over particles in index order produces it: each pair force is added to both particles
+// (scatter) as its owner i comes. Once its sums are complete a particle is finished at once (finishParticle:
+// walls, torque, statistics, the caller's per-particle step such as the Verlet corrector), so a step reads the
+// particles once: particle i's sums are complete right after its own pairs, since its partners j > i come later
+// and never see it again, and the pairs where it is the partner came before.
+// With T threads the particles are cut into T contiguous ranges (PairList::split) and each thread runs that pass
+// over its range. Only the "cross" pairs, whose partner lies in a later range, reach outside a range; they are
+// evaluated first, each into its own slot. A range then adds the cross pairs in which its particles are partners
+// (in pair order: they all precede the range's own pairs), and takes its own cross pairs from their slots in
+// their place among its pairs. Same additions in the same order as with one thread, so the same bits. After a
+// spatial sort the ranges are slabs of space and the cross pairs lie along their faces: a few per cent.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -27,16 +30,6 @@
 
 namespace haet {
 
-/// Buffers of the threaded path, kept between steps so that no step allocates (the serial path needs none).
-template <int D>
-struct ForceScratch {
-    std::vector<Vec<D>> pairForce;   ///< force on i of each pair [N]
-    std::vector<Ang<D>> pairNxFt;    ///< n x F_t of each pair [N]
-    std::vector<double> maxOverlap;  ///< per particle: largest overlap / smaller radius, pairs and walls
-    std::vector<std::uint32_t> contacts;  ///< per particle: own pairs and walls in contact
-    std::vector<double> virial;      ///< per particle: sum over own pairs of r_ij . F_ij [N m]
-};
-
 struct ForceStats {
     static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
     std::size_t contacts = 0;        ///< pair and wall contacts
@@ -44,6 +37,35 @@ struct ForceStats {
     std::size_t worstParticle = 0;   ///< particle with that overlap
     double virial = 0;               ///< sum over pair contacts of r_ij . F_ij, summed particle by particle [J]
     std::size_t nonFinite = kNone;   ///< first particle with a non-finite position or force, or kNone
+};
+
+/// What forceRange reports of its particles: ForceStats without the virial, which is summed per particle.
+struct RangeTally {
+    std::size_t contacts = 0;
+    double maxOverlapRatio = 0;
+    std::size_t worstParticle = 0;
+    std::size_t nonFinite = ForceStats::kNone;
+};
+
+/// A cross pair evaluated before the ranges run (threaded path).
+template <int D>
+struct CrossPair {
+    Vec<D> f;         ///< force on i [N]
+    Ang<D> nxft;      ///< n x F_t [N]
+    double virial;    ///< r_ij . F_ij [N m]
+    double overlap;   ///< overlap / smaller radius
+    bool touching;
+};
+
+/// Buffers of the threaded paths, kept between steps so that no step allocates (one thread needs none).
+template <int D>
+struct ForceScratch {
+    std::vector<CrossPair<D>> cross;  ///< the disk loop's cross pairs (PairList::split)
+    std::vector<Vec<D>> pairForce;    ///< polygon loop: force on i of each pair [N]
+    std::vector<double> maxOverlap;   ///< polygon loop, per particle: largest overlap / smaller radius
+    std::vector<std::uint32_t> contacts;  ///< polygon loop, per particle: own pairs and walls in contact
+    std::vector<double> virial;       ///< per particle: sum over own pairs of r_ij . F_ij [N m]
+    std::vector<RangeTally> tally;    ///< the disk loop's per-range statistics
 };
 
 /// Force of one pair: F on i (on j: -F) and n x F_t (torque on each: -a (n x F_t)).
@@ -95,7 +117,9 @@ template <int D, class Normal, class Tangential>
                                             PairForce<D>& out, double& overlapRatio, double& virial) {
     using V = KernelVec<D>;
     const std::uint32_t j = in.partner[k];
-    const V d = a.x - kernelVec(in.x[j]) + kernelVec(in.shiftVec[in.shift[k]]);
+    V d = a.x - kernelVec(in.x[j]);
+    // Most pairs do not cross a periodic boundary: their shift is zero and costs a load and an add less.
+    if (in.shift[k] != PairList<D>::kNoShift) d += kernelVec(in.shiftVec[in.shift[k]]);
     const double ri = a.radius, rj = in.radius[j];
     const double rsum = ri + rj;
     const double dist2 = norm2(d);
@@ -141,16 +165,16 @@ struct ParticleTally {
 };
 
 /// Particle i's pair sums are complete (f: force, nx: sum of n x F_t): adds its wall contacts (in wall order),
-/// stores force and torque -a (sum) + wall torques, then runs the caller's per-particle step.
+/// stores force and torque -a (sum) + wall torques, then runs the caller's per-particle step then(i, f, torque).
 template <int D, class Normal, class Tangential, class Then>
 [[gnu::always_inline]] inline ParticleTally finishParticle(Particles<D>& p, const PairInputs<D>& in,
-                                                          const std::vector<Wall<D>>& walls,
+                                                          const Wall<D>* walls, std::size_t nw,
                                                           Vec<D>* wallHistory, const ContactSetup& cs,
-                                                          double time, std::size_t i, Vec<D> f, const Ang<D>& nx,
-                                                          double worst, std::uint32_t contacts, Then& then) {
-    const double ri = p.radius[i];
+                                                          double time, std::size_t i, const Owner<D>& a, Vec<D> f,
+                                                          const Ang<D>& nx, double worst, std::uint32_t contacts,
+                                                          Then& then) {
+    const double ri = a.radius;
     Ang<D> tq = nx * (-ri);
-    const std::size_t nw = walls.size();
     if (nw > 0 && !(p.flags[i] & kFrozen)) {
         for (std::size_t w = 0; w < nw; ++w) {
             const Wall<D>& wall = walls[w];
@@ -181,15 +205,99 @@ template <int D, class Normal, class Tangential, class Then>
     }
     p.f[i] = f;
     p.torque[i] = tq;
+    const Vec<D> x = storedVec(a.x);
     double s = 0;  // a NaN anywhere reaches the force of its particle in the same step
-    for (int k = 0; k < D; ++k) s += f[k] + p.x[i][k];
-    then(i);
+    for (int k = 0; k < D; ++k) s += f[k] + x[k];
+    then(i, f, tq);
     return {worst, contacts, std::isfinite(s)};
+}
+
+/// The pass over particles [b, e), which holds every partner of their pairs except the cross pairs (kCross:
+/// partner >= e), evaluated before into cross[c0...] in pair order; crossIn: the cross pairs whose partner is in
+/// [b, e), by partner then pair. Per-particle virial sums go to virial[i] when a thread split needs them kept
+/// apart, else into *virialSum (in particle order either way).
+template <int D, class Normal, class Tangential, bool kCross, class Then>
+[[gnu::always_inline]] inline RangeTally forceRange(Particles<D>& p, const PairInputs<D>& in,
+                                                     const std::uint32_t* first, const Wall<D>* walls, std::size_t nw,
+                                                     Vec<D>* wh, const ContactSetup& cs, double time, const Vec<D>& g,
+                                                     std::size_t b, std::size_t e, const CrossPair<D>* cross,
+                                                     std::size_t c0, const std::uint64_t* crossIn,
+                                                     const std::uint64_t* crossInEnd, double* virial,
+                                                     double* virialSum, Then& then) {
+    Vec<D>* f = p.f.data();
+    Ang<D>* nx = p.torque.data();  // holds the sums of n x F_t until the particle is finished
+    const double* mass = p.mass.data();
+    // A particle's sums start (gravity, then the cross pairs where it is the partner) just before the first pair
+    // that adds to them: particles [b, done) have started. Each row is sorted by partner, so its last pair reaches
+    // farthest; starting the sums there, not in a pass of their own, keeps them in cache until they are used.
+    std::size_t done = b;
+    const std::uint64_t* q = crossIn;
+    auto startUpTo = [&](std::size_t end) {
+        for (; done < end; ++done) {
+            f[done] = g * mass[done];
+            nx[done] = Ang<D>::zero();
+            if constexpr (kCross) {
+                for (; q != crossInEnd && (*q >> 32) == done; ++q) {
+                    const CrossPair<D>& c = cross[*q & 0xFFFFFFFFu];
+                    if (!c.touching) continue;
+                    f[done] -= c.f;
+                    nx[done] += c.nxft;
+                }
+            }
+        }
+    };
+    RangeTally st;
+    std::size_t c = c0;
+    for (std::size_t i = b; i < e; ++i) {
+        const std::uint32_t k0 = first[i], k1 = first[i + 1];
+        std::size_t reach = k1 > k0 ? std::size_t{in.partner[k1 - 1]} + 1 : i + 1;
+        if constexpr (kCross) reach = std::min(reach, e);
+        startUpTo(std::max(reach, i + 1));
+        const Owner<D> a(in, i);
+        KernelVec<D> fi = kernelVec(f[i]);
+        KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
+        double worst = 0, vir = 0;
+        std::uint32_t nc = 0;
+        for (std::uint32_t k = k0; k < k1; ++k) {
+            const std::uint32_t j = in.partner[k];
+            if constexpr (kCross) {
+                if (j >= e) {
+                    const CrossPair<D>& x = cross[c++];
+                    if (!x.touching) continue;
+                    fi += kernelVec(x.f);
+                    nxi += kernelVec(x.nxft);
+                    vir += x.virial;
+                    worst = std::max(worst, x.overlap);
+                    ++nc;
+                    continue;
+                }
+            }
+            PairForce<D> pf;
+            if (!evalPair<D, Normal, Tangential>(in, a, k, pf, worst, vir)) continue;
+            fi += pf.f;
+            nxi += pf.nxft;
+            f[j] = storedVec(kernelVec(f[j]) - pf.f);
+            nx[j] = storedVec(kernelVec(nx[j]) + pf.nxft);
+            ++nc;
+        }
+        const ParticleTally t = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, a,
+                                                                      storedVec(fi), storedVec(nxi), worst, nc, then);
+        st.contacts += t.contacts;
+        if constexpr (kCross) virial[i] = vir;
+        else *virialSum += vir;
+        if (t.worst > st.maxOverlapRatio) {
+            st.maxOverlapRatio = t.worst;
+            st.worstParticle = i;
+        }
+        if (!t.finite && st.nonFinite == ForceStats::kNone) st.nonFinite = i;
+    }
+    return st;
 }
 
 /// Forces at the predicted state. sv/sw: mean velocities over the last step (StepMotion), which increment
 /// the tangential springs; the damping terms use the predicted velocities p.v, p.w. then(i) runs once particle
-/// i's force and torque are final (it may change i's velocities, not its position; nothing reads them after).
+/// i's force and torque are final, with them: then(i, f, torque) (it may change i's velocities, not its position;
+/// nothing reads them after).
 template <int D, class Normal, class Tangential, class Then>
 ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wall<D>>& walls,
                          std::vector<Vec<D>>& wallHistory, const ContactSetup& cs, const Domain<D>& dom,
@@ -202,111 +310,65 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
                            cs.table.data(),   cs.nMaterials,   !cs.attraction,   dt};
     const std::uint32_t* first = pl.first.data();
     Vec<D>* wh = wallHistory.data();
+    const Wall<D>* wp = walls.data();
+    const std::size_t nw = walls.size();
     const Vec<D> g = dom.gravity;
-    const bool threaded = n >= kParallelMin && omp_get_max_threads() > 1;
+    const int nt = n >= kParallelMin ? omp_get_max_threads() : 1;
     ForceStats st;
 
-    if (!threaded) {
-        Vec<D>* f = p.f.data();
-        Ang<D>* nx = p.torque.data();  // holds the sums of n x F_t until the particle is finished
-        for (std::size_t i = 0; i < n; ++i) {
-            f[i] = g * p.mass[i];
-            nx[i] = Ang<D>::zero();
-        }
-        for (std::size_t i = 0; i < n; ++i) {
-            const Owner<D> a(in, i);
-            KernelVec<D> fi = kernelVec(f[i]);
-            KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
-            double worst = 0, vir = 0;
-            std::uint32_t nc = 0;
-            for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
-                PairForce<D> pf;
-                if (!evalPair<D, Normal, Tangential>(in, a, k, pf, worst, vir)) continue;
-                const std::uint32_t j = in.partner[k];
-                fi += pf.f;
-                nxi += pf.nxft;
-                f[j] = storedVec(kernelVec(f[j]) - pf.f);
-                nx[j] = storedVec(kernelVec(nx[j]) + pf.nxft);
-                ++nc;
-            }
-            const ParticleTally t = finishParticle<D, Normal, Tangential>(
-                p, in, walls, wh, cs, time, i, storedVec(fi), storedVec(nxi), worst, nc, then);
-            st.contacts += t.contacts;
-            st.virial += vir;
-            if (t.worst > st.maxOverlapRatio) {
-                st.maxOverlapRatio = t.worst;
-                st.worstParticle = i;
-            }
-            if (!t.finite && st.nonFinite == ForceStats::kNone) st.nonFinite = i;
-        }
+    if (nt <= 1) {
+        const RangeTally t = forceRange<D, Normal, Tangential, false>(p, in, first, wp, nw, wh, cs, time, g, 0, n,
+                                                                      nullptr, 0, nullptr, nullptr, nullptr,
+                                                                      &st.virial, then);
+        st.contacts = t.contacts;
+        st.maxOverlapRatio = t.maxOverlapRatio;
+        st.worstParticle = t.worstParticle;
+        st.nonFinite = t.nonFinite;
         return st;
     }
 
-    if (pl.firstT.size() != n + 1) buildTransposedIndex(pl);
-    const std::size_t np = pl.size();
-    s.pairForce.resize(np);
-    s.pairNxFt.resize(np);
-    s.maxOverlap.resize(n);
-    s.contacts.resize(n);
+    if (pl.split.ranges() != static_cast<std::size_t>(nt)) buildThreadSplit(pl, nt);
+    const ThreadSplit& sp = pl.split;
+    const std::size_t ncross = sp.crossSlot.size();
+    s.cross.resize(ncross);
     s.virial.resize(n);
-    Vec<D>* pairForce = s.pairForce.data();
-    Ang<D>* pairNxFt = s.pairNxFt.data();
-    std::size_t nonFinite = ForceStats::kNone;
-#pragma omp parallel
+    CrossPair<D>* cross = s.cross.data();
+    s.tally.assign(static_cast<std::size_t>(nt), RangeTally{});
+    RangeTally* tally = s.tally.data();
+#pragma omp parallel num_threads(nt)
     {
-#pragma omp for schedule(dynamic, 512)
-        for (std::size_t i = 0; i < n; ++i) {
-            const Owner<D> a(in, i);
-            double worst = 0, vir = 0;
-            std::uint32_t nc = 0;
-            for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
-                PairForce<D> pf;
-                if (evalPair<D, Normal, Tangential>(in, a, k, pf, worst, vir)) {
-                    ++nc;
-                    pairForce[k] = storedVec(pf.f);
-                    pairNxFt[k] = storedVec(pf.nxft);
-                } else {
-                    pairForce[k] = Vec<D>::zero();
-                    pairNxFt[k] = Ang<D>::zero();
-                }
+        // The cross pairs first: every particle is still unfinished.
+#pragma omp for schedule(static)
+        for (std::size_t c = 0; c < ncross; ++c) {
+            const Owner<D> a(in, sp.crossOwner[c]);
+            PairForce<D> pf;
+            CrossPair<D>& x = cross[c];
+            x.overlap = 0;
+            x.virial = 0;
+            x.touching = evalPair<D, Normal, Tangential>(in, a, sp.crossSlot[c], pf, x.overlap, x.virial);
+            if (x.touching) {
+                x.f = storedVec(pf.f);
+                x.nxft = storedVec(pf.nxft);
             }
-            s.maxOverlap[i] = worst;
-            s.contacts[i] = nc;
-            s.virial[i] = vir;
         }
-        // Pass 1, which reads every particle, is over (the barrier of the loop above).
-#pragma omp for schedule(static) reduction(min : nonFinite)
-        for (std::size_t i = 0; i < n; ++i) {
-            Vec<D> f = g * p.mass[i];
-            Ang<D> nx = Ang<D>::zero();
-            for (std::uint32_t q = pl.firstT[i]; q < pl.firstT[i + 1]; ++q) {
-                const std::uint32_t k = pl.pairT[q];
-                if (pairForce[k] == Vec<D>::zero() && pairNxFt[k] == Ang<D>::zero()) continue;
-                f -= pairForce[k];
-                nx += pairNxFt[k];
-            }
-            for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
-                if (pairForce[k] == Vec<D>::zero() && pairNxFt[k] == Ang<D>::zero()) continue;
-                f += pairForce[k];
-                nx += pairNxFt[k];
-            }
-            const ParticleTally t = finishParticle<D, Normal, Tangential>(p, in, walls, wh, cs, time, i, f, nx,
-                                                                          s.maxOverlap[i], s.contacts[i], then);
-            s.maxOverlap[i] = t.worst;
-            s.contacts[i] = t.contacts;
-            if (!t.finite) nonFinite = std::min(nonFinite, i);
+#pragma omp for schedule(static, 1)
+        for (int r = 0; r < nt; ++r) {
+            const std::uint64_t* ci = sp.crossIn.data();
+            tally[r] = forceRange<D, Normal, Tangential, true>(
+                p, in, first, wp, nw, wh, cs, time, g, sp.start[r], sp.start[r + 1], cross, sp.crossFirst[r],
+                ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1], s.virial.data(), nullptr, then);
         }
     }
-    // The serial path's reductions, in the same order.
-    for (std::size_t i = 0; i < n; ++i) {
-        st.contacts += s.contacts[i];
-        st.virial += s.virial[i];
-        if (s.maxOverlap[i] > st.maxOverlapRatio) {
-            st.maxOverlapRatio = s.maxOverlap[i];
-            st.worstParticle = i;
+    // The one-thread reductions, in the same order.
+    for (const RangeTally& t : s.tally) {
+        st.contacts += t.contacts;
+        if (t.maxOverlapRatio > st.maxOverlapRatio) {
+            st.maxOverlapRatio = t.maxOverlapRatio;
+            st.worstParticle = t.worstParticle;
         }
+        if (st.nonFinite == ForceStats::kNone) st.nonFinite = t.nonFinite;
     }
-    st.nonFinite = nonFinite;
+    for (std::size_t i = 0; i < n; ++i) st.virial += s.virial[i];
     return st;
 }
 

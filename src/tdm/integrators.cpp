@@ -80,7 +80,7 @@ void VelocityVerlet<D>::correct(Particles<D>& p, double dt) {
     const std::size_t n = p.tdmCount();
     const Corrector c = corrector(p, dt);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) c(i);
+    for (std::size_t i = 0; i < n; ++i) c(i, p.f[i], p.torque[i]);
 }
 
 template <int D>

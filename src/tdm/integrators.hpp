@@ -50,23 +50,30 @@ public:
     void remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) override;
 
     /// The corrector of one particle, for a force loop that finishes particles one at a time (TdmEngine runs it
-    /// inside the force pass); correct() runs it over all particles.
+    /// inside the force pass, with the particle's new force and torque at hand); correct() runs it over all.
     struct Corrector {
-        Particles<D>& p;
+        Vec<D>* v;
+        Ang<D>* w;
         Vec<D>* acc;
         Ang<D>* alpha;
+        const double* invMass;
+        const double* invInertia;
+        const std::uint8_t* flags;
         double h;  ///< dt / 2 [s]
-        void operator()(std::size_t i) const {
-            if (p.flags[i] & kFrozen) return;
-            const Vec<D> a = p.f[i] * p.invMass[i];
-            const Ang<D> al = p.torque[i] * p.invInertia[i];
-            p.v[i] += (a - acc[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
-            p.w[i] += (al - alpha[i]) * h;
+        void operator()(std::size_t i, const Vec<D>& f, const Ang<D>& torque) const {
+            if (flags[i] & kFrozen) return;
+            const Vec<D> a = f * invMass[i];
+            const Ang<D> al = torque * invInertia[i];
+            v[i] += (a - acc[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
+            w[i] += (al - alpha[i]) * h;
             acc[i] = a;
             alpha[i] = al;
         }
     };
-    Corrector corrector(Particles<D>& p, double dt) { return {p, acc_.data(), alpha_.data(), 0.5 * dt}; }
+    Corrector corrector(Particles<D>& p, double dt) {
+        return {p.v.data(),       p.w.data(),          acc_.data(),      alpha_.data(),
+                p.invMass.data(), p.invInertia.data(), p.flags.data(),   0.5 * dt};
+    }
 
 private:
     std::vector<Vec<D>> acc_;    ///< a(t) [m/s^2]
