@@ -117,12 +117,13 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
     bj.invInertia = p.invInertia[j];
     const PolygonCoeffs& c = cs.polygonPair(p.material[i], p.material[j]);
     const double rmin = std::min(ri, rj);
-    const ContactForce cf = polygonContact(c, o, bi, bj, nullptr, 0.01 * rmin, cs.attraction, cs.tangential == TangentialLaw::Spring,
-                                           dt, hist);
+    const PairLengths len = pairLengths(ri, rj);
+    const ContactForce cf = polygonContact(c, o, bi, bj, nullptr, len, cs.attraction,
+                                           cs.tangential == TangentialLaw::Spring, dt, hist);
     out.f = cf.f;
     out.ti = cf.torqueI;
     out.tj = cf.torqueJ;
-    out.energy = polygonContactEnergy(c, o, cf.length);
+    out.energy = polygonContactEnergy(c, o, cf, len);
     virial += dot(d, cf.f);
     // Depth of the overlap, area / chord, relative to the smaller bounding radius (1 when the chord vanishes).
     const double clen = norm(o.chord);
@@ -275,11 +276,12 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
                     bw.v = wall.velocity;
                     bw.vStep = wall.velocity;
                     const PolygonCoeffs& c = cs.polygonPair(p.material[i], wall.material);
-                    const ContactForce cf = polygonContact(c, o, bi, bw, &nrm, 0.01 * ri, cs.attraction,
+                    const PairLengths len = wallLengths(ri);
+                    const ContactForce cf = polygonContact(c, o, bi, bw, &nrm, len, cs.attraction,
                                                            cs.tangential == TangentialLaw::Spring, dt, hist);
                     f += cf.f;
                     tq += cf.torqueI;
-                    ps.wallEnergy[i] += polygonContactEnergy(c, o, cf.length);
+                    ps.wallEnergy[i] += polygonContactEnergy(c, o, cf, len);
                     const double clen = norm(o.chord);
                     s.maxOverlap[i] = std::max(s.maxOverlap[i], clen > 0 ? o.area / clen / ri : 1.0);
                     ++wallContacts;
