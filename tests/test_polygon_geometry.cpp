@@ -248,6 +248,30 @@ TEST(PolygonOverlap, HalfPlaneCutsTheRightPart) {
     EXPECT_EQ(halfPlaneOverlap(sq.data(), 4, V2{{0, -1.0}}, V2{{0, 1}}).area, 0.0);  // resting exactly on it
 }
 
+// The inscribed circle about the centroid: R cos(pi/n) for a regular n-gon, half the short side of a rectangle; two
+// polygons whose inscribed circles overlap always overlap (the force loop then skips its separating-axis test).
+TEST(PolygonGeometry, InradiusAndOverlappingInscribedCircles) {
+    for (int n = 3; n <= 12; ++n) {
+        const auto v = regularPolygon(n, 0.7, 0.3);
+        EXPECT_NEAR(inradius(v.data(), n), 0.7 * std::cos(kPi / n), 1e-14) << n;
+    }
+    const auto r = rectangle(3.0, std::sqrt(10.0), 0.4);  // 6 x 2
+    EXPECT_NEAR(inradius(r.data(), 4), 1.0, 1e-14);
+    Rng rng(51, 3);
+    int checked = 0;
+    for (int t = 0; t < 500; ++t) {
+        const auto Pb = randomConvexPolygon(rng, 3 + t % 10, 1.0, 2.0, 0);
+        const auto Qb = randomConvexPolygon(rng, 3 + (t / 10) % 10, 0.7, 2.0, 0);
+        const double rin = inradius(Pb.data(), int(Pb.size())) + inradius(Qb.data(), int(Qb.size()));
+        const double ang = rng.uniform(0, 2 * kPi), dist = rng.uniform(0.0, 0.999) * rin;
+        const auto P = moved(Pb, V2{{dist * std::cos(ang), dist * std::sin(ang)}}, 0.0);
+        const auto Q = moved(Qb, V2::zero(), 0.0);
+        EXPECT_GT(clipOverlap(P.data(), int(P.size()), Q.data(), int(Q.size())).area, 0.0) << t;
+        ++checked;
+    }
+    EXPECT_EQ(checked, 500);
+}
+
 // ---- degenerate geometry: finite results, documented fallbacks ----
 
 TEST(PolygonOverlap, DegenerateContactsStayFinite) {

@@ -30,12 +30,17 @@ struct PolygonScratch {
     std::vector<double> pairEnergy; ///< estimated elastic energy of each pair [J] (contactEnergy)
     std::vector<double> wallEnergy; ///< per particle: estimated elastic energy of its wall contacts [J]
     std::vector<double> torque;     ///< per particle: pair torques [N m]
+    std::vector<double> inradius;   ///< per shape: distance from the centroid to the nearest edge line [m]
 };
 
+
 /// Turns every polygon's body-frame vertices by its current angle.
+/// Also keeps the inradius of every shape (shapes are only ever added).
 inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
     const ShapeTable& st = p.shapes;
     ps.rotated.resize(st.vertices.size());
+    for (std::size_t s = ps.inradius.size(); s < st.size(); ++s)
+        ps.inradius.push_back(inradius(st.of(std::uint32_t(s)), st.count(std::uint32_t(s))));
     const std::size_t n = p.tdmCount();
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
@@ -74,15 +79,16 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
         const int np = st.count(si), nq = st.count(sj);
         const V2* a = ps.rotated.data() + st.first[si];
         const V2* b = ps.rotated.data() + st.first[sj];
-        // Broad phase passed (bounding circles): the line of centres separates most remaining pairs cheaply (P's
+        // Broad phase passed (bounding circles). Inscribed circles that overlap mean overlapping polygons (most
+        // touching pairs of a packing); otherwise the line of centres separates most remaining pairs cheaply (P's
         // projections on d are a's shifted by |d|^2); the clipping finds that the others do not overlap (the full
         // separating-axis test, polygon::separated, would cost about as much as the clipping).
-        if (dist2 > 0 && separatedAlong(d, dist2, a, np, b, nq)) {
+        const double rin = ps.inradius[si] + ps.inradius[sj];
+        if (dist2 >= rin * rin && dist2 > 0 && separatedAlong(d, dist2, a, np, b, nq)) {
             if (!(hist == V2::zero())) hist = V2::zero();
             return false;
         }
-        for (int m = 0; m < np; ++m) P[m] = a[m] + d;
-        o = clipOverlap(P.data(), np, b, nq, nullptr, &d, ri);
+        o = clipOverlap(a, np, b, nq, nullptr, &d, ri, &d);
     } else if (si != kNoShape) {  // polygon i, disk j: the circle at the origin
         const int np = st.count(si);
         const V2* a = ps.rotated.data() + st.first[si];
@@ -140,9 +146,9 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
     const std::size_t n = p.tdmCount();
     const std::size_t np = pl.size();
     rotateShapes(p, ps);
-    s.maxOverlap.assign(n, 0.0);
-    s.contacts.assign(n, 0);
-    s.virial.assign(n, 0.0);
+    s.maxOverlap.resize(n);  // these three are written for every particle below
+    s.contacts.resize(n);
+    s.virial.resize(n);
     ps.wallEnergy.assign(n, 0.0);
     ps.pairEnergy.assign(np, 0.0);
     std::vector<double>& torque = ps.torque;
