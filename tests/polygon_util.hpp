@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "contact/setup.hpp"
+#include "physics_util.hpp"
 #include "core/rng.hpp"
 #include "polygon/geometry.hpp"
 #include "tdm/engine.hpp"
@@ -16,10 +17,13 @@ namespace haet::testing {
 /// Relative change of the kinetic energy (translation + rotation) over one collision of two random convex polygons
 /// (elastic, frictionless: no damping, no friction), integrated with Gear5 at dtFactor x the polygon rule.
 /// `seed` picks the shapes, orientations, the sideways offset of the approach and the spins.
-inline double collisionEnergyChange(std::uint64_t seed, double dtFactor) {
+/// `law`, `young` [N/m]: the normal law and its stiffness.
+inline double collisionEnergyChange(std::uint64_t seed, double dtFactor, PolygonLaw law = PolygonLaw::OverlapArea,
+                                    double young = 1e4) {
     Rng rng(seed, 777);
     Scenario sc = linearScenario(2, 1.0, 1e-3, 0.0, TangentialLaw::None);
-    sc.materials[0].young = 1e4;
+    sc.materials[0].young = young;
+    sc.contact.polygonLaw = law;
     sc.materials[0].density = 2.0;
     World<2> w;
     w.domain = openBox<2>(0.1);
@@ -53,6 +57,41 @@ inline double collisionEnergyChange(std::uint64_t seed, double dtFactor) {
         if (touched && !contact) break;
     }
     return energy() / e0 - 1;
+}
+
+/// Energy of the elastic, frictionless polygon gas of tests/data/polygon_gas.toml (120 polygons, Gear5 at the polygon
+/// time step) under the normal law `law`, Young's modulus `young` [N/m] (0: the file's), over `steps` steps. The
+/// energy is read at instants without any contact, where it is purely kinetic.
+struct GasEnergy {
+    double drift = 0;         ///< largest |E / E0 - 1| over the contact-free instants
+    int samples = 0;          ///< contact-free instants
+    double collisions = 0;    ///< contact-steps / 10 (a contact lasts about ten steps)
+    double maxOverlap = 0;    ///< largest overlap depth A/|c| over the smaller bounding radius
+    std::size_t particles = 0;
+};
+
+inline GasEnergy gasEnergy(PolygonLaw law, int steps, double young = 0) {
+    Scenario sc = dataScenario("polygon_gas.toml");
+    sc.contact.polygonLaw = law;
+    if (young > 0) sc.materials[0].young = young;
+    World<2> w = buildWorld<2>(sc);
+    TdmEngine<2> eng(w, tdmSettings<2>(sc, w));
+    const double e0 = kineticEnergy(w.particles);
+    GasEnergy g;
+    g.particles = w.particles.size();
+    double contactSteps = 0;
+    for (int k = 1; k <= steps; ++k) {
+        eng.step();
+        const ForceStats& fs = eng.forceStats();
+        contactSteps += double(fs.contacts);
+        g.maxOverlap = std::max(g.maxOverlap, fs.maxOverlapRatio);
+        if (fs.contacts == 0) {
+            g.drift = std::max(g.drift, std::abs(kineticEnergy(w.particles) / e0 - 1));
+            ++g.samples;
+        }
+    }
+    g.collisions = contactSteps / 10;
+    return g;
 }
 
 }  // namespace haet::testing

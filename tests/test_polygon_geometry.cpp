@@ -248,6 +248,30 @@ TEST(PolygonOverlap, HalfPlaneCutsTheRightPart) {
     EXPECT_EQ(halfPlaneOverlap(sq.data(), 4, V2{{0, -1.0}}, V2{{0, 1}}).area, 0.0);  // resting exactly on it
 }
 
+// The inscribed circle about the centroid: R cos(pi/n) for a regular n-gon, half the short side of a rectangle; two
+// polygons whose inscribed circles overlap always overlap (the force loop then skips its separating-axis test).
+TEST(PolygonGeometry, InradiusAndOverlappingInscribedCircles) {
+    for (int n = 3; n <= 12; ++n) {
+        const auto v = regularPolygon(n, 0.7, 0.3);
+        EXPECT_NEAR(inradius(v.data(), n), 0.7 * std::cos(kPi / n), 1e-14) << n;
+    }
+    const auto r = rectangle(3.0, std::sqrt(10.0), 0.4);  // 6 x 2
+    EXPECT_NEAR(inradius(r.data(), 4), 1.0, 1e-14);
+    Rng rng(51, 3);
+    int checked = 0;
+    for (int t = 0; t < 500; ++t) {
+        const auto Pb = randomConvexPolygon(rng, 3 + t % 10, 1.0, 2.0, 0);
+        const auto Qb = randomConvexPolygon(rng, 3 + (t / 10) % 10, 0.7, 2.0, 0);
+        const double rin = inradius(Pb.data(), int(Pb.size())) + inradius(Qb.data(), int(Qb.size()));
+        const double ang = rng.uniform(0, 2 * kPi), dist = rng.uniform(0.0, 0.999) * rin;
+        const auto P = moved(Pb, V2{{dist * std::cos(ang), dist * std::sin(ang)}}, 0.0);
+        const auto Q = moved(Qb, V2::zero(), 0.0);
+        EXPECT_GT(clipOverlap(P.data(), int(P.size()), Q.data(), int(Q.size())).area, 0.0) << t;
+        ++checked;
+    }
+    EXPECT_EQ(checked, 500);
+}
+
 // ---- degenerate geometry: finite results, documented fallbacks ----
 
 TEST(PolygonOverlap, DegenerateContactsStayFinite) {
@@ -283,7 +307,7 @@ TEST(PolygonOverlap, DegenerateContactsStayFinite) {
     bj.x = V2{{0.0, 0.1}};
     bi.v = V2{{0.3, -0.2}};
     V2 xi{};
-    const ContactForce f = polygonContact(c, oc, bi, bj, nullptr, 0.01, false, true, 1e-4, xi);
+    const ContactForce f = polygonContact(c, oc, bi, bj, nullptr, PairLengths{0.01, 1.0}, false, true, 1e-4, xi);
     EXPECT_TRUE(std::isfinite(f.f[0]) && std::isfinite(f.f[1]) && std::isfinite(f.torqueI));
     EXPECT_NEAR(f.normal[1], -1.0, 1e-12);  // from j (above) to i
     // One inside the other, same centre: chord zero, normal +x, finite.
@@ -291,7 +315,7 @@ TEST(PolygonOverlap, DegenerateContactsStayFinite) {
     const Overlap oi = clipOverlap(small.data(), 4, sq.data(), 4);
     EXPECT_NEAR(oi.area, 0.18, 1e-14);
     bj.x = V2::zero();
-    const ContactForce fi = polygonContact(c, oi, bi, bj, nullptr, 0.01, false, true, 1e-4, xi);
+    const ContactForce fi = polygonContact(c, oi, bi, bj, nullptr, PairLengths{0.01, 1.0}, false, true, 1e-4, xi);
     EXPECT_EQ(fi.normal[0], 1.0);
     EXPECT_TRUE(std::isfinite(fi.f[0]) && std::isfinite(fi.f[1]) && std::isfinite(fi.torqueI));
 }
@@ -327,51 +351,110 @@ TEST(PolygonContact, AreaRateMatchesFiniteDifferences) {
     EXPECT_GT(checked, 50);
 }
 
+// Both normal laws: the force on j is minus the force on i whichever body's outline gives the chord, and the torques
+// balance the moment of the pair force, so momentum and angular momentum are conserved.
 TEST(PolygonContact, NewtonsThirdLawAndTorqueBalance) {
-    Rng rng(31, 4);
+    for (const PolygonLaw law : {PolygonLaw::OverlapArea, PolygonLaw::Potential}) {
+        const std::string name = law == PolygonLaw::Potential ? "potential" : "overlap_area";
+        Rng rng(31, 4);
+        PolygonCoeffs c;
+        c.young = 2e6;
+        c.gamma = 0.4;
+        c.kt = 2.0 / 7.0 * c.young;
+        c.gammaT = 0.25;
+        c.mu = 0.6;
+        c.law = law;
+        const PairLengths len = pairLengths(0.01, 0.012);
+        double worstF = 0, worstT = 0;
+        int checked = 0;
+        for (int t = 0; t < 400; ++t) {
+            const auto P =
+                moved(randomConvexPolygon(rng, 3 + t % 12, 0.01, 2.0, 0), V2{{0.3, 0.2}}, rng.uniform(0, 6));
+            const auto Q = moved(randomConvexPolygon(rng, 3 + t % 7, 0.012, 2.0, 0),
+                                 V2{{0.3 + rng.uniform(-0.015, 0.015), 0.2 + rng.uniform(-0.015, 0.015)}},
+                                 rng.uniform(0, 6));
+            const Overlap oij = clipOverlap(P.data(), int(P.size()), Q.data(), int(Q.size()));
+            const Overlap oji = clipOverlap(Q.data(), int(Q.size()), P.data(), int(P.size()));
+            if (oij.area < 1e-8) continue;
+            BodyState bi, bj;
+            bi.x = polygonMoments(P.data(), int(P.size())).centroid;
+            bj.x = polygonMoments(Q.data(), int(Q.size())).centroid;
+            bi.v = bi.vStep = V2{{rng.uniform(-1, 1), rng.uniform(-1, 1)}};
+            bj.v = bj.vStep = V2{{rng.uniform(-1, 1), rng.uniform(-1, 1)}};
+            bi.w = bi.wStep = rng.uniform(-50, 50);
+            bj.w = bj.wStep = rng.uniform(-50, 50);
+            bi.invMass = 1 / 0.3, bj.invMass = 1 / 0.5;
+            bi.invInertia = 1e5, bj.invInertia = 5e4;
+            const V2 xi0{{rng.uniform(-1e-5, 1e-5), rng.uniform(-1e-5, 1e-5)}};
+            V2 xiA = xi0, xiB = -xi0;  // the spring of (j, i) is minus that of (i, j)
+            const ContactForce a = polygonContact(c, oij, bi, bj, nullptr, len, false, true, 1e-5, xiA);
+            const ContactForce b = polygonContact(c, oji, bj, bi, nullptr, len, false, true, 1e-5, xiB);
+            const double scale = norm(a.f) + 1e-300;
+            worstF = std::max(worstF, norm(a.f + b.f) / scale);
+            EXPECT_LT(norm(a.f + b.f), 1e-8 * scale) << name << " " << t;
+            EXPECT_LT(norm(xiA + xiB), 1e-8 * (norm(xiA) + 1e-20)) << name << " " << t;
+            EXPECT_NEAR(a.torqueI, b.torqueJ, 1e-8 * (std::abs(a.torqueI) + std::abs(b.torqueJ)) + 1e-300)
+                << name << " " << t;
+            // Angular momentum: tau_i + tau_j + (x_i - x_j) x F_i = 0, up to round-off.
+            const double bal = a.torqueI + a.torqueJ + cross2(bi.x - bj.x, a.f);
+            const double tScale = std::abs(a.torqueI) + std::abs(a.torqueJ) + norm(bi.x - bj.x) * scale;
+            worstT = std::max(worstT, std::abs(bal) / tScale);
+            EXPECT_LT(std::abs(bal), 1e-13 * tScale) << name << " " << t;
+            ++checked;
+        }
+        EXPECT_GT(checked, 100);
+        record("worst_force_asymmetry_" + name, worstF);
+        record("worst_torque_imbalance_" + name, worstT);
+    }
+}
+
+// The potential law is minus the gradient of U = Y A^2 / (2 L^2) (polygonContactEnergy): the force on i and the
+// torques on i and j match central differences of U under translation of i and rotation of i and of j about their
+// centres, over random overlaps of random convex polygons.
+TEST(PolygonContact, PotentialLawIsTheGradientOfItsEnergy) {
+    Rng rng(41, 6);
     PolygonCoeffs c;
-    c.young = 2e6;
-    c.gamma = 0.4;
-    c.kt = 2.0 / 7.0 * c.young;
-    c.gammaT = 0.25;
-    c.mu = 0.6;
-    double worstF = 0, worstT = 0;
+    c.young = 1e5;
+    c.law = PolygonLaw::Potential;
+    const PairLengths len = pairLengths(1.0, 0.8);
+    double worst = 0;
     int checked = 0;
-    for (int t = 0; t < 400; ++t) {
-        const auto P = moved(randomConvexPolygon(rng, 3 + t % 12, 0.01, 2.0, 0), V2{{0.3, 0.2}}, rng.uniform(0, 6));
-        const auto Q = moved(randomConvexPolygon(rng, 3 + t % 7, 0.012, 2.0, 0),
-                             V2{{0.3 + rng.uniform(-0.015, 0.015), 0.2 + rng.uniform(-0.015, 0.015)}},
-                             rng.uniform(0, 6));
-        const Overlap oij = clipOverlap(P.data(), int(P.size()), Q.data(), int(Q.size()));
-        const Overlap oji = clipOverlap(Q.data(), int(Q.size()), P.data(), int(P.size()));
-        if (oij.area < 1e-8) continue;
+    for (int t = 0; t < 300; ++t) {
+        const auto Pb = randomConvexPolygon(rng, 3 + t % 8, 1.0, 2.0, 0);
+        const auto Qb = randomConvexPolygon(rng, 3 + (t / 8) % 8, 0.8, 2.0, 0);
+        const V2 xi{{rng.uniform(-0.8, 0.8), rng.uniform(-0.8, 0.8)}};
+        const V2 xj{{rng.uniform(-0.8, 0.8), rng.uniform(-0.8, 0.8)}};
+        const double ai = rng.uniform(0, 6), aj = rng.uniform(0, 6);
+        auto energy = [&](const V2& dxi, double dai, double daj) {
+            const auto P = moved(Pb, xi + dxi, ai + dai);
+            const auto Q = moved(Qb, xj, aj + daj);
+            const Overlap o = clipOverlap(P.data(), int(P.size()), Q.data(), int(Q.size()));
+            return o.area > 0 ? polygonContactEnergy(c, o, ContactForce{}, len) : 0.0;
+        };
+        const auto P = moved(Pb, xi, ai);
+        const auto Q = moved(Qb, xj, aj);
+        const Overlap o = clipOverlap(P.data(), int(P.size()), Q.data(), int(Q.size()));
+        if (o.area < 0.05 || norm(o.chord) < 0.1) continue;
         BodyState bi, bj;
-        bi.x = polygonMoments(P.data(), int(P.size())).centroid;
-        bj.x = polygonMoments(Q.data(), int(Q.size())).centroid;
-        bi.v = bi.vStep = V2{{rng.uniform(-1, 1), rng.uniform(-1, 1)}};
-        bj.v = bj.vStep = V2{{rng.uniform(-1, 1), rng.uniform(-1, 1)}};
-        bi.w = bi.wStep = rng.uniform(-50, 50);
-        bj.w = bj.wStep = rng.uniform(-50, 50);
-        bi.invMass = 1 / 0.3, bj.invMass = 1 / 0.5;
-        bi.invInertia = 1e5, bj.invInertia = 5e4;
-        const V2 xi0{{rng.uniform(-1e-5, 1e-5), rng.uniform(-1e-5, 1e-5)}};
-        V2 xiA = xi0, xiB = -xi0;  // the spring of (j, i) is minus that of (i, j)
-        const ContactForce a = polygonContact(c, oij, bi, bj, nullptr, 1e-4, false, true, 1e-5, xiA);
-        const ContactForce b = polygonContact(c, oji, bj, bi, nullptr, 1e-4, false, true, 1e-5, xiB);
-        const double scale = norm(a.f) + 1e-300;
-        worstF = std::max(worstF, norm(a.f + b.f) / scale);
-        EXPECT_LT(norm(a.f + b.f), 1e-8 * scale) << t;
-        EXPECT_LT(norm(xiA + xiB), 1e-8 * (norm(xiA) + 1e-20)) << t;
-        // Angular momentum: tau_i + tau_j + (x_i - x_j) x F_i = 0, up to round-off.
-        const double bal = a.torqueI + a.torqueJ + cross2(bi.x - bj.x, a.f);
-        const double tScale = std::abs(a.torqueI) + std::abs(a.torqueJ) + norm(bi.x - bj.x) * scale;
-        worstT = std::max(worstT, std::abs(bal) / tScale);
-        EXPECT_LT(std::abs(bal), 1e-13 * tScale) << t;
+        bi.x = xi;
+        bj.x = xj;
+        bi.invMass = bj.invMass = 1;
+        V2 spring{};
+        const ContactForce f = polygonContact(c, o, bi, bj, nullptr, len, false, false, 1e-5, spring);
+        const double h = 1e-6;
+        const V2 hx{{h, 0}}, hy{{0, h}};
+        const V2 grad{{(energy(hx, 0, 0) - energy(-hx, 0, 0)) / (2 * h),
+                       (energy(hy, 0, 0) - energy(-hy, 0, 0)) / (2 * h)}};
+        const double dai = (energy(V2::zero(), h, 0) - energy(V2::zero(), -h, 0)) / (2 * h);
+        const double daj = (energy(V2::zero(), 0, h) - energy(V2::zero(), 0, -h)) / (2 * h);
+        const double scale = norm(f.f) * (1 + norm(xi - xj));
+        const double err = std::max({norm(f.f + grad), std::abs(f.torqueI + dai), std::abs(f.torqueJ + daj)}) / scale;
+        worst = std::max(worst, err);
+        EXPECT_LT(err, 1e-5) << t;
         ++checked;
     }
-    EXPECT_GT(checked, 100);
-    record("worst_force_asymmetry", worstF);
-    record("worst_torque_imbalance", worstT);
+    EXPECT_GT(checked, 50);
+    record("worst_gradient_error", worst);
 }
 
 }  // namespace

@@ -238,6 +238,9 @@ TEST_F(PolygonScenario, BadPolygonKeysNameFileLineAndKey) {
               std::string::npos);
     const std::string h = replaced(kPolygons, "polygon = \"random\"", "polygon = \"star\"");
     expectError(h, lineOf(h, "polygon = \"star\""), "insert[2].polygon");
+    const std::string law = replaced(kPolygons, "[[walls]]", "[contact]\npolygon_law = \"exact\"\n\n[[walls]]");
+    EXPECT_NE(expectError(law, lineOf(law, "polygon_law"), "contact.polygon_law").find("\"potential\""),
+              std::string::npos);
     // A disk insert brings back the linear law's duration.
     const std::string disks = replaced(kPolygons, "[[walls]]", "[contact]\ntangential = \"spring\"\n\n[[walls]]") +
                               "\n[[insert]]\ncount = 3\nradius = 0.001\nmaterial = \"grain\"\n";
@@ -247,6 +250,22 @@ TEST_F(PolygonScenario, BadPolygonKeysNameFileLineAndKey) {
     std::string err;
     EXPECT_EQ(run("check '" + write("bad2.toml", a).string() + "'", &err), 2);
     EXPECT_NE(err.find("insert[1].sides"), std::string::npos) << err;
+    EXPECT_EQ(run("check '" + write("bad3.toml", law).string() + "'", &err), 2);
+    EXPECT_NE(err.find("contact.polygon_law"), std::string::npos) << err;
+}
+
+// contact.polygon_law picks the normal law of every polygon pair; the default is the overlap-area law (G.3).
+TEST_F(PolygonScenario, PolygonLawKey) {
+    const Scenario byDefault = loadScenario(write("a.toml", kPolygons));
+    EXPECT_EQ(byDefault.contact.polygonLaw, PolygonLaw::OverlapArea);
+    World<2> w = buildWorld<2>(byDefault);
+    EXPECT_EQ(w.contact.polygonPair(0, 0).law, PolygonLaw::OverlapArea);
+    const Scenario pot = loadScenario(
+        write("b.toml", replaced(kPolygons, "[[walls]]", "[contact]\npolygon_law = \"potential\"\n\n[[walls]]")));
+    EXPECT_EQ(pot.contact.polygonLaw, PolygonLaw::Potential);
+    World<2> wp = buildWorld<2>(pot);
+    EXPECT_EQ(wp.contact.polygonPair(0, 0).law, PolygonLaw::Potential);
+    EXPECT_EQ(wp.contact.polygonStep, w.contact.polygonStep);
 }
 
 TEST_F(PolygonScenario, RunWritesPolygonCellsAndPicture) {

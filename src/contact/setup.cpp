@@ -198,6 +198,7 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
             pc.young = 2 * ma.young * mb.young / (ma.young + mb.young);
             pc.gamma = cd.polygonDamping ? *cd.polygonDamping : -2 * lne / std::sqrt(kPi * kPi + lne * lne);
             pc.mu = c.mu;
+            pc.law = cd.polygonLaw;
             if (cd.tangential == TangentialLaw::Spring) {
                 pc.kt = cd.kt ? *cd.kt : (cd.ktRatio ? *cd.ktRatio : 2.0 / 7.0) * pc.young;
                 pc.gammaT = e < 1 ? 0.25 : 0.0;  // Matuttis-Chen's 0.25 sqrt(k_t m_t); none in an elastic scene

@@ -14,9 +14,24 @@
 //                   1/m_t = 1/m_i + 1/m_j + |r_i|^2/I_i + |r_j|^2/I_j
 //   torques         tau_i = (r_i x F)_z, tau_j = -(r_j x F)_z, F the force on i
 // Since tau_i + tau_j + (x_i - x_j) x F = 0, pair forces conserve linear and angular momentum exactly.
+//
+// This law has no potential: an elastic collision with spin or an offset approach changes the pair's energy, and
+// the change does not vanish with dt (docs/scenario.md, Polygons). The energy-conserving variant
+// (PolygonLaw::Potential, after Feng & Owen, Eng. Comput. 21, 265 (2004)) derives the force from U = Phi(A),
+// Phi = Y A^2 / (2 L^2) with L^2 a constant of the pair. Since translating body i by dx changes A by
+// -|c| n . dx and turning it by dphi about x_i changes A by -(s + r_i . c) dphi (geometry.hpp), -grad U is
+//   elastic         F_el = Phi'(A) |c| = Y A |c| / L^2 along n
+//   force point     P = C + (s / |c|^2) c, the chord's midpoint when the outlines cross twice; the torque on i is
+//                   then F_el (s + r_i . c) / |c| = -dU/dphi_i
+//   length          L^2 = 4 R_i R_j / (R_i + R_j) x min(R_i, R_j), from the bounding radii (a wall: 4 R_i^2): about
+//                   the overlap-area law's stiffness for a flat contact as wide as the smaller bounding radius
+//   damping         F_d = gamma sqrt(m_eff Y) (dA/dt) |c| / L^2, from the dissipation function
+//                   gamma sqrt(m_eff Y) (dA/dt)^2 / (2 L^2); limiter and clipping as above
+// and r_i, r_j, the relative velocity and the tangential force are taken at P.
 #include <cmath>
 
 #include "polygon/geometry.hpp"
+#include "scenario/definition.hpp"
 
 namespace haet::polygon {
 
@@ -27,7 +42,23 @@ struct PolygonCoeffs {
     double kt = 0;      ///< tangential spring stiffness [N/m]; 0 = no tangential force
     double gammaT = 0;  ///< tangential damping: F = -gammaT sqrt(k_t m_t) g_t [-]
     double mu = 0;      ///< Coulomb friction [-]
+    PolygonLaw law = PolygonLaw::OverlapArea;  ///< normal force: G.3, or the energy-conserving variant
 };
+
+/// Lengths of a pair that the law takes from the bodies' bounding radii.
+struct PairLengths {
+    double lMin = 0;       ///< floor of l [m]
+    double potential = 0;  ///< L^2 of PolygonLaw::Potential [m^2]
+};
+
+/// Two bodies of bounding radii ri, rj [m]: l >= 1 % of the smaller, L^2 = 4 ri rj / (ri + rj) x min(ri, rj).
+inline PairLengths pairLengths(double ri, double rj) {
+    const double rmin = std::min(ri, rj);
+    return PairLengths{0.01 * rmin, 4 * ri * rj / (ri + rj) * rmin};
+}
+
+/// A body of bounding radius ri [m] against a wall (rj infinite): l >= 1 % of ri, L^2 = 4 ri^2.
+inline PairLengths wallLengths(double ri) { return PairLengths{0.01 * ri, 4 * ri * ri}; }
 
 /// Motion of one body in the pair's frame (any common origin).
 struct BodyState {
@@ -46,7 +77,7 @@ struct ContactForce {
     double torqueJ = 0;  ///< [N m]
     double fn = 0;       ///< normal force [N]
     V2 normal{};         ///< unit normal, from j to i
-    double length = 0;   ///< characteristic length l [m]
+    double length = 0;   ///< characteristic length l [m] (overlap-area law; 0 for the potential law)
 };
 
 /// Rate of change of the overlap area [m^2/s] under the bodies' rigid motion, exact (geometry.hpp):
@@ -61,40 +92,52 @@ inline double areaRate(const Overlap& o, const BodyState& bi, const BodyState& b
 /// `wallNormal` (unit, pointing to i) replaces the chord's normal and makes j a wall: then l = 4 |r_i|.
 /// xi: the tangential spring [m], stored as a vector along t so that it changes sign with the pair's order.
 /// When the chord vanishes (one body inside the other) the normal falls back to the line of centres, and to +x
-/// when the centres coincide.
+/// when the centres coincide; the potential law's force then vanishes with |c| (a depth that max_overlap stops).
 inline ContactForce polygonContact(const PolygonCoeffs& c, const Overlap& o, const BodyState& bi,
-                                   const BodyState& bj, const V2* wallNormal, double lMin, bool attraction,
-                                   bool friction, double dt, V2& xi) {
+                                   const BodyState& bj, const V2* wallNormal, const PairLengths& len,
+                                   bool attraction, bool friction, double dt, V2& xi) {
     ContactForce out;
     const double clen = norm(o.chord);
+    const bool hasChord = clen > 1e-12 * std::sqrt(o.area);
     V2 n;
     if (wallNormal) {
         n = *wallNormal;
-    } else if (clen > 1e-12 * std::sqrt(o.area)) {
+    } else if (hasChord) {
         n = perp(o.chord) / clen;
     } else {
         const V2 d = bi.x - bj.x;
         const double dl = norm(d);
         n = dl > 0 ? d / dl : V2{{1.0, 0.0}};
     }
-    const V2 ri = o.centroid - bi.x, rj = o.centroid - bj.x;
-    const double li = norm(ri);
-    double l;
-    if (wallNormal) {
-        l = 4 * li;
+    // Elastic force [N] and force point; l (overlap-area law) or |c| / L^2 (potential law) [1/m].
+    const bool potential = c.law == PolygonLaw::Potential;
+    double fel, l = 0, cOverL2 = 0;
+    V2 at = o.centroid;
+    if (potential) {
+        if (hasChord) at += o.chord * (o.spin / (clen * clen));
+        cOverL2 = clen / len.potential;
+        fel = c.young * o.area * cOverL2;
     } else {
-        const double lj = norm(rj);
-        l = li + lj > 0 ? 4 * li * lj / (li + lj) : 0.0;
+        const double li = norm(at - bi.x);
+        if (wallNormal) {
+            l = 4 * li;
+        } else {
+            const double lj = norm(at - bj.x);
+            l = li + lj > 0 ? 4 * li * lj / (li + lj) : 0.0;
+        }
+        l = std::max(l, len.lMin);
+        fel = c.young * o.area / l;
     }
-    l = std::max(l, lMin);
-    const double fel = c.young * o.area / l;
+    out.length = l;
+    const V2 ri = at - bi.x, rj = at - bj.x;
 
     // Relative velocity of the force point, and the rate of change of the overlap area.
     const V2 g = bi.v + perp(ri) * bi.w - bj.v - perp(rj) * bj.w;
     const double dAdt = areaRate(o, bi, bj);
     const double invM = bi.invMass + bj.invMass;
     const double meff = invM > 0 ? 1.0 / invM : 0.0;
-    double fd = c.gamma * std::sqrt(meff * c.young) * dAdt / l;
+    const double damping = c.gamma * std::sqrt(meff * c.young) * dAdt;
+    double fd = potential ? damping * cOverL2 : damping / l;
     if (fd > 2 * fel) fd = fel;
     double fn = fel + fd;
     if (!attraction && fn < 0) fn = 0;
@@ -103,8 +146,8 @@ inline ContactForce polygonContact(const PolygonCoeffs& c, const Overlap& o, con
     if (friction && c.kt > 0) {
         const V2 t = perp(n);
         // The contact line turns with the pair: keep the spring's length, take its sign along the new tangent.
-        const double len = norm(xi);
-        double s = dot(xi, t) >= 0 ? len : -len;
+        const double xl = norm(xi);
+        double s = dot(xi, t) >= 0 ? xl : -xl;
         const V2 gs = bi.vStep + perp(ri) * bi.wStep - bj.vStep - perp(rj) * bj.wStep;
         s += dot(gs, t) * dt;
         const double gt = dot(g, t);
@@ -124,15 +167,17 @@ inline ContactForce polygonContact(const PolygonCoeffs& c, const Overlap& o, con
     out.torqueJ = -cross2(rj, f);
     out.fn = fn;
     out.normal = n;
-    out.length = l;
     return out;
 }
 
-/// Elastic energy of a contact, estimated as Y A^2 / (2 l |c|): exact for a flat contact (A = |c| depth), 3/4 of
-/// the work done for a vertex contact (A ~ depth^2). The law has no potential in general (PHYSICS.md G.3).
-inline double polygonContactEnergy(const PolygonCoeffs& c, const Overlap& o, double l) {
+/// Elastic energy of a contact [J]. The potential law's is exact, Y A^2 / (2 L^2). The overlap-area law has no
+/// potential (PHYSICS.md G.3); its energy is estimated as Y A^2 / (2 l |c|): exact for a flat contact
+/// (A = |c| depth), 3/4 of the work done for a vertex contact (A ~ depth^2).
+inline double polygonContactEnergy(const PolygonCoeffs& c, const Overlap& o, const ContactForce& f,
+                                   const PairLengths& len) {
+    if (c.law == PolygonLaw::Potential) return c.young * o.area * o.area / (2 * len.potential);
     const double clen = norm(o.chord);
-    return clen > 0 && l > 0 ? c.young * o.area * o.area / (2 * l * clen) : 0.0;
+    return clen > 0 && f.length > 0 ? c.young * o.area * o.area / (2 * f.length * clen) : 0.0;
 }
 
 }  // namespace haet::polygon

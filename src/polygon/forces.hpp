@@ -30,12 +30,17 @@ struct PolygonScratch {
     std::vector<double> pairEnergy; ///< estimated elastic energy of each pair [J] (contactEnergy)
     std::vector<double> wallEnergy; ///< per particle: estimated elastic energy of its wall contacts [J]
     std::vector<double> torque;     ///< per particle: pair torques [N m]
+    std::vector<double> inradius;   ///< per shape: distance from the centroid to the nearest edge line [m]
 };
 
+
 /// Turns every polygon's body-frame vertices by its current angle.
+/// Also keeps the inradius of every shape (shapes are only ever added).
 inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
     const ShapeTable& st = p.shapes;
     ps.rotated.resize(st.vertices.size());
+    for (std::size_t s = ps.inradius.size(); s < st.size(); ++s)
+        ps.inradius.push_back(inradius(st.of(std::uint32_t(s)), st.count(std::uint32_t(s))));
     const std::size_t n = p.tdmCount();
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
@@ -74,15 +79,16 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
         const int np = st.count(si), nq = st.count(sj);
         const V2* a = ps.rotated.data() + st.first[si];
         const V2* b = ps.rotated.data() + st.first[sj];
-        // Broad phase passed (bounding circles): the line of centres separates most remaining pairs cheaply (P's
+        // Broad phase passed (bounding circles). Inscribed circles that overlap mean overlapping polygons (most
+        // touching pairs of a packing); otherwise the line of centres separates most remaining pairs cheaply (P's
         // projections on d are a's shifted by |d|^2); the clipping finds that the others do not overlap (the full
         // separating-axis test, polygon::separated, would cost about as much as the clipping).
-        if (dist2 > 0 && separatedAlong(d, dist2, a, np, b, nq)) {
+        const double rin = ps.inradius[si] + ps.inradius[sj];
+        if (dist2 >= rin * rin && dist2 > 0 && separatedAlong(d, dist2, a, np, b, nq)) {
             if (!(hist == V2::zero())) hist = V2::zero();
             return false;
         }
-        for (int m = 0; m < np; ++m) P[m] = a[m] + d;
-        o = clipOverlap(P.data(), np, b, nq, nullptr, &d, ri);
+        o = clipOverlap(a, np, b, nq, nullptr, &d, ri, &d);
     } else if (si != kNoShape) {  // polygon i, disk j: the circle at the origin
         const int np = st.count(si);
         const V2* a = ps.rotated.data() + st.first[si];
@@ -117,12 +123,13 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
     bj.invInertia = p.invInertia[j];
     const PolygonCoeffs& c = cs.polygonPair(p.material[i], p.material[j]);
     const double rmin = std::min(ri, rj);
-    const ContactForce cf = polygonContact(c, o, bi, bj, nullptr, 0.01 * rmin, cs.attraction, cs.tangential == TangentialLaw::Spring,
-                                           dt, hist);
+    const PairLengths len = pairLengths(ri, rj);
+    const ContactForce cf = polygonContact(c, o, bi, bj, nullptr, len, cs.attraction,
+                                           cs.tangential == TangentialLaw::Spring, dt, hist);
     out.f = cf.f;
     out.ti = cf.torqueI;
     out.tj = cf.torqueJ;
-    out.energy = polygonContactEnergy(c, o, cf.length);
+    out.energy = polygonContactEnergy(c, o, cf, len);
     virial += dot(d, cf.f);
     // Depth of the overlap, area / chord, relative to the smaller bounding radius (1 when the chord vanishes).
     const double clen = norm(o.chord);
@@ -139,9 +146,9 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
     const std::size_t n = p.tdmCount();
     const std::size_t np = pl.size();
     rotateShapes(p, ps);
-    s.maxOverlap.assign(n, 0.0);
-    s.contacts.assign(n, 0);
-    s.virial.assign(n, 0.0);
+    s.maxOverlap.resize(n);  // these three are written for every particle below
+    s.contacts.resize(n);
+    s.virial.resize(n);
     ps.wallEnergy.assign(n, 0.0);
     ps.pairEnergy.assign(np, 0.0);
     std::vector<double>& torque = ps.torque;
@@ -275,11 +282,12 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
                     bw.v = wall.velocity;
                     bw.vStep = wall.velocity;
                     const PolygonCoeffs& c = cs.polygonPair(p.material[i], wall.material);
-                    const ContactForce cf = polygonContact(c, o, bi, bw, &nrm, 0.01 * ri, cs.attraction,
+                    const PairLengths len = wallLengths(ri);
+                    const ContactForce cf = polygonContact(c, o, bi, bw, &nrm, len, cs.attraction,
                                                            cs.tangential == TangentialLaw::Spring, dt, hist);
                     f += cf.f;
                     tq += cf.torqueI;
-                    ps.wallEnergy[i] += polygonContactEnergy(c, o, cf.length);
+                    ps.wallEnergy[i] += polygonContactEnergy(c, o, cf, len);
                     const double clen = norm(o.chord);
                     s.maxOverlap[i] = std::max(s.maxOverlap[i], clen > 0 ? o.area / clen / ri : 1.0);
                     ++wallContacts;

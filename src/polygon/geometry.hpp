@@ -22,6 +22,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/rng.hpp"
@@ -92,6 +93,17 @@ inline double circumradius(const V2* v, int n, const V2& c) {
     double r2 = 0;
     for (int k = 0; k < n; ++k) r2 = std::max(r2, norm2(v[k] - c));
     return std::sqrt(r2);
+}
+
+/// Distance from the origin to the nearest edge line of a convex counter-clockwise polygon that holds the origin
+/// [m]: the radius of the largest circle about the origin inside the polygon.
+inline double inradius(const V2* v, int n) {
+    double r = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < n; ++k) {
+        const V2 e = v[k + 1 == n ? 0 : k + 1] - v[k];
+        r = std::min(r, cross2(e, -v[k]) / norm(e));
+    }
+    return r;
 }
 
 /// True when the vertices are in counter-clockwise order and every corner turns left (strictly convex up to a
@@ -205,8 +217,9 @@ struct Overlap {
 /// against every edge of Q. Vertices beyond kMaxVertices per polygon are not supported. If `out` is given it
 /// receives the overlap polygon (capacity kMaxClip). `pCentre`, `pRadius`: a circle holding P, if known; an edge of Q
 /// whose inner half-plane holds that whole circle cannot cut P and is skipped (one test instead of one per vertex).
+/// `pShift`: if given, P is taken moved by it (P[k] + *pShift), as the force loop keeps vertices about the centre.
 inline Overlap clipOverlap(const V2* P, int np, const V2* Q, int nq, V2* out = nullptr, const V2* pCentre = nullptr,
-                           double pRadius = 0) {
+                           double pRadius = 0, const V2* pShift = nullptr) {
     // Each vertex carries the owner of the edge that leaves it: 0 = P's outline, 1 = Q's.
     VertexBuffer<kMaxClip> bufA, bufB;
     std::uint8_t tagA[kMaxClip], tagB[kMaxClip];
@@ -216,7 +229,7 @@ inline Overlap clipOverlap(const V2* P, int np, const V2* Q, int nq, V2* out = n
     std::uint8_t* nt = tagB;
     int n = np;
     for (int k = 0; k < np; ++k) {
-        cur[k] = P[k];
+        cur[k] = pShift ? P[k] + *pShift : P[k];
         ct[k] = 0;
     }
     for (int e = 0; e < nq && n >= 3; ++e) {

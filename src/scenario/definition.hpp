@@ -17,6 +17,8 @@ enum class Method { Tdm, Edm, Haet };
 enum class NormalLaw { Linear, Hertz };
 enum class HertzDamping { None, Viscoelastic, Tsuji };
 enum class TangentialLaw { None, Spring };
+/// Normal force of contacts involving a polygon (PHYSICS.md G.3; docs/scenario.md, Polygons).
+enum class PolygonLaw { OverlapArea, Potential };
 enum class IntegratorKind { Verlet, Gear5 };
 enum class Arrangement { Lattice, Random, File };
 enum class FileFormat { Csv, LammpsData };
@@ -83,6 +85,8 @@ struct ContactDef {
     double impactVelocity = 1.0;   ///< Hertz: impact speed used for t_c and the time-step rule [m/s]
     /// Polygon contacts: dimensionless normal damping gamma of PHYSICS.md G.3; default from the restitution
     std::optional<double> polygonDamping;
+    /// Polygon contacts: F = Y A / l at the overlap centroid (G.3), or the energy-conserving F = Y A |c| / L^2
+    PolygonLaw polygonLaw = PolygonLaw::OverlapArea;
     SourcePos pos;
 };
 

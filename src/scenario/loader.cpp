@@ -320,7 +320,7 @@ private:
     void readContact(Scenario& s) {
         const TableReader r = child("contact");
         r.allowOnly({"normal", "duration", "kn", "gamma_n", "damping", "tangential", "kt", "kt_ratio", "gamma_t",
-                     "attraction", "impact_velocity", "polygon_damping"});
+                     "attraction", "impact_velocity", "polygon_damping", "polygon_law"});
         ContactDef& c = s.contact;
         c.pos = r.tablePos();
         c.normal = r.choice<NormalLaw>("normal", {{"linear", NormalLaw::Linear}, {"hertz", NormalLaw::Hertz}})
@@ -367,6 +367,9 @@ private:
         if (!(c.impactVelocity > 0)) r.fail("impact_velocity", "must be > 0");
         c.polygonDamping = r.number("polygon_damping");
         if (c.polygonDamping && !(*c.polygonDamping >= 0)) r.fail("polygon_damping", "must be >= 0");
+        c.polygonLaw = r.choice<PolygonLaw>("polygon_law", {{"overlap_area", PolygonLaw::OverlapArea},
+                                                            {"potential", PolygonLaw::Potential}})
+                           .value_or(PolygonLaw::OverlapArea);
     }
 
     /// The linear law needs (duration or kn) as soon as the scene may hold disks: a disk insert or a particle file.
