@@ -565,8 +565,10 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
                                      [](std::uint8_t f) { return f & kFrozen; }),
                        sc.materials.size(), world.walls.size());
     if (world.particles.hasPolygons())
-        out << fmt::format("polygons   {} (overlap-area law, PHYSICS.md G.3; the rest are disks)\n",
-                           world.particles.shapes.size());
+        out << fmt::format("polygons   {} ({}; the rest are disks)\n", world.particles.shapes.size(),
+                           sc.contact.polygonLaw == PolygonLaw::Potential
+                               ? "potential law Y A |c| / L^2 at the chord midpoint, energy-conserving"
+                               : "overlap-area law Y A / l, PHYSICS.md G.3");
     out << fmt::format("contact    {} normal law, {} tangential; contact duration t_c = {:.4g} s ({})\n",
                        sc.contact.normal == NormalLaw::Linear ? "linear" : "hertz",
                        sc.contact.tangential == TangentialLaw::Spring ? "spring" : "no",
