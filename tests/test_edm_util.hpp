@@ -145,8 +145,7 @@ namespace haet::testing {
 /// hard-sphere (disk) gas, measured over `collisions` collisions after `equilibrate` collisions per particle;
 /// shell: EdmSettings::shell.
 template <int D>
-double measureZ(int n, double phi, std::uint64_t collisions, double equilibrate, std::uint64_t seed,
-                double shell = 0) {
+double measureZ(int n, double phi, std::uint64_t collisions, double equilibrate, std::uint64_t seed, double shell = 0) {
     GasSpec g;
     g.n = n;
     g.phi = phi;

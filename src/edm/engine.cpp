@@ -415,7 +415,9 @@ double EdmEngine<D>::wallTime(std::uint32_t s, std::size_t w, double now) const 
 // The canonical form of pairTime for moving slot s (state hs) and slot j seen through the image shift m, written
 // out for speed: the older of the two states is extrapolated to the other's clock (an extrapolation by zero leaves a
 // state unchanged, so skipping it gives the same bits). A candidate whose root cannot come before bestTime gives
-// kNever without the square root or the division.
+// kNever without the square root or the division. The same arithmetic as the cell scan in predict, which keeps its
+// own copy: written there with the image shift of the cell and gravity hoisted out of the loop, the cell scan took
+// 7 % fewer instructions (callgrind, 3D phi = 0.1 and 0.3).
 template <int D>
 inline double EdmEngine<D>::candidateTime(const Hot& hs, std::uint32_t s, std::uint32_t j, const Shift& m, double now,
                                           double bestTime) const {
@@ -556,29 +558,72 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
         __builtin_prefetch(&hot_[heads[q]]);
         __builtin_prefetch(&link_[heads[q]]);
     }
-    // Candidates later than the best pair or wall event so far are skipped (candidateTime), but never because they
-    // are later than the cell exit: rec_[s].coll must stay the earliest over all neighbours for the partial scans
-    // after a crossing.
-    std::uint32_t bestJ = kNil;
+    // The canonical form of pairTime, written out for speed: the older of the two states is extrapolated to the
+    // other's clock (an extrapolation by zero leaves a state unchanged, so skipping it gives the same bits).
+    // Candidates later than the best pair or wall event so far are skipped before the square root, but never
+    // because they are later than the cell exit: rec_[s].coll must stay the earliest over all neighbours for the
+    // partial scans after a crossing.
+    const double ts = hs.t;
+    double gHalf[D];
+    for (int k = 0; k < D; ++k) gHalf[k] = 0.5 * g_[k];
     for (int q = 0; q < nc; ++q) {
         const Shift& base = interior ? negWs : bases[q];
         for (std::uint32_t j = heads[q]; j != kNil;) {
             const Link& lj = link_[j];
             const std::uint32_t nextJ = lj.next;
             if (j != s) {
-                Shift m;
-                for (int k = 0; k < D; ++k) m[k] = base[k] + lj.wrap[k];
-                const double t = candidateTime(hs, s, j, m, now, best.time);
-                const std::uint32_t code = (kPair << kTypeShift) | j;
-                if (best.better(t, code)) {
-                    best = {t, code, 0};
-                    bestJ = j;
+                const Hot& hj = hot_[j];
+                double t = kNever;
+                if (hj.t == kNever) {
+                    Shift m;
+                    for (int k = 0; k < D; ++k) m[k] = base[k] + lj.wrap[k];
+                    t = pairTime(s, j, m, now, best.time);
+                } else {
+                    double r[D], v[D], tr;
+                    if (hj.t <= ts) {
+                        tr = ts;
+                        const double db = ts - hj.t;
+                        for (int k = 0; k < D; ++k) {
+                            const double xb = hj.x[k] + (hj.v[k] + gHalf[k] * db) * db;
+                            r[k] = (hs.x[k] - xb) + (base[k] + lj.wrap[k]) * boxLen_[k];
+                            v[k] = hs.v[k] - (hj.v[k] + g_[k] * db);
+                        }
+                    } else {
+                        tr = hj.t;
+                        const double da = hj.t - ts;
+                        for (int k = 0; k < D; ++k) {
+                            const double xa = hs.x[k] + (hs.v[k] + gHalf[k] * da) * da;
+                            r[k] = (xa - hj.x[k]) + (base[k] + lj.wrap[k]) * boxLen_[k];
+                            v[k] = (hs.v[k] + g_[k] * da) - hj.v[k];
+                        }
+                    }
+                    double b = 0;
+                    for (int k = 0; k < D; ++k) b += r[k] * v[k];
+                    if (b < 0) {
+                        const double sigma = hs.r + hj.r;
+                        double r2 = 0;
+                        for (int k = 0; k < D; ++k) r2 += r[k] * r[k];
+                        const double c = r2 - sigma * sigma;
+                        // Lower bound of the root: c / (-2 b). Beyond the best event so far: no sqrt, no division.
+                        const double left = best.time - tr;
+                        if (!(c > 0 && c > -2 * b * left * (1 + 1e-12))) {
+                            double v2 = 0;
+                            for (int k = 0; k < D; ++k) v2 += v[k] * v[k];
+                            t = tr + firstRootFalling(c, 2 * b, 2 * v2);
+                            if (t < now) {
+                                Shift m;
+                                for (int k = 0; k < D; ++k) m[k] = base[k] + lj.wrap[k];
+                                t = pairTimeFromNow(s, j, m, now);
+                            }
+                        }
+                    }
                 }
+                const std::uint32_t code = (kPair << kTypeShift) | j;
+                if (best.better(t, code)) best = {t, code, lj.count};
             }
             j = nextJ;
         }
     }
-    if (bestJ != kNil) best.stamp = link_[bestJ].count;
     rec_[s].coll = best;
     const Candidate& next = cross.better(best.time, best.code) ? best : cross;
     rec_[s].evCode = next.code;
@@ -799,8 +844,7 @@ void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
         if (periodic_) {
             const std::uint32_t image = a[q] >> kImageShift;
             const Shift& wj = link_[j].wrap;
-            for (int k = 0; k < D; ++k)
-                m[k] = wj[k] - ws[k] - (static_cast<std::int32_t>((image >> (2 * k)) & 3u) - 1);
+            for (int k = 0; k < D; ++k) m[k] = wj[k] - ws[k] - (static_cast<std::int32_t>((image >> (2 * k)) & 3u) - 1);
         }
         const double t = candidateTime(hs, s, j, m, now, best.time);
         const std::uint32_t code = (kPair << kTypeShift) | j;
@@ -919,7 +963,8 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     advance(b, t);
     const bool elastic = tcElastic(a, fb ? kNil : b, t);
     bool hop = false;
-    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(p.material[i], p.material[j], elastic), approaching, gn, uRest, hop);
+    const Vec<D> P =
+        impulseWithHop(b1, b2, n, lawFor(p.material[i], p.material[j], elastic), approaching, gn, uRest, hop);
     const double before = kineticEnergy(b1) + kineticEnergy(b2);
     applyImpulse(b1, b2, n, P);
     stats_.dissipated += before - kineticEnergy(b1) - kineticEnergy(b2);
@@ -1265,8 +1310,7 @@ std::uint32_t EdmEngine<D>::zoneOfCell(std::uint32_t c) const {
 
 template <int D>
 void EdmEngine<D>::attachZones(const EdmZoneLink<D>& link) {
-    if (shells_)
-        throw std::logic_error("event-driven engine: zones need cell crossings (EdmSettings::shell = 0)");
+    if (shells_) throw std::logic_error("event-driven engine: zones need cell crossings (EdmSettings::shell = 0)");
     if (link.guard == nullptr || link.guard->size() != head_.size())
         throw std::invalid_argument("event-driven engine: the guard must have one entry per cell");
     for (int k = 0; k < D; ++k)

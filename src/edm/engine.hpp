@@ -194,8 +194,8 @@ public:
     double cellSize() const;               ///< smallest cell edge of the grid [m]
     /// Thickness of the neighbour shells in use [m] (0: cell crossings).
     double shellThickness() const { return shells_ ? 2 * shellHalf_ : 0; }
-    double nextEventTime() const;          ///< time of the next pending event [s] (reference mode: infinity)
-    std::size_t memoryBytes() const;       ///< heap memory of the engine's own arrays [bytes]
+    double nextEventTime() const;     ///< time of the next pending event [s] (reference mode: infinity)
+    std::size_t memoryBytes() const;  ///< heap memory of the engine's own arrays [bytes]
 
 private:
     enum Type : std::uint32_t { kPair = 0, kWall = 1, kCell = 2, kNone = 3 };
