@@ -1,5 +1,7 @@
 // Collisions per second of the event-driven engine on elastic smooth hard-sphere (disk) gases, one thread:
 // 3D at phi = 0.1, 0.3, 0.45 and 2D at phi = 0.3, N = 10^5 (goal: >= 3 10^5 collisions/s for 3D phi = 0.3).
+// Arguments: N, phi in percent, neighbour-shell thickness in percent of a diameter (0: cell crossings, the default;
+// EdmSettings::shell).
 // Start: simple cubic (square) lattice with Gaussian velocities, then ~3 collisions per particle to equilibrate
 // (not timed). Each iteration advances the gas by about N collisions. Counters: collisions per second, events
 // per collision, bytes per particle (engine's own arrays, and with the shared particle store).
@@ -29,6 +31,7 @@ template <int D>
 void gas(benchmark::State& state) {
     const int n = static_cast<int>(state.range(0));
     const double phi = static_cast<double>(state.range(1)) / 100.0;
+    const double shell = static_cast<double>(state.range(2)) / 100.0;
     haet::testing::GasSpec g;
     g.n = n;
     g.phi = phi;
@@ -37,6 +40,7 @@ void gas(benchmark::State& state) {
     w.particles.dropTdmState();  // as a method = "edm" run does
     haet::EdmSettings s;
     s.tcModel = false;
+    s.shell = shell;
     haet::EdmEngine<D> eng(w, s);
     double t = 0;
     while (eng.collisions() < 3.0 * n) eng.advanceTo(t += 0.05);
@@ -49,6 +53,7 @@ void gas(benchmark::State& state) {
     state.counters["events_per_collision"] = static_cast<double>(eng.events() - e0) / coll;
     state.counters["engine_bytes_per_particle"] = static_cast<double>(eng.memoryBytes()) / n;
     state.counters["total_bytes_per_particle"] = static_cast<double>(eng.memoryBytes() + storeBytes(w.particles)) / n;
+    state.counters["shell"] = eng.shellThickness() / (2 * g.radius);
 }
 
 void gas3(benchmark::State& s) { gas<3>(s); }
@@ -56,12 +61,13 @@ void gas2(benchmark::State& s) { gas<2>(s); }
 
 BENCHMARK(gas3)
     ->Name("EdmGas3D")
-    ->Args({100000, 10})
-    ->Args({100000, 30})
-    ->Args({100000, 45})
+    ->Args({100000, 10, 0})
+    ->Args({100000, 30, 0})
+    ->Args({100000, 45, 0})
+    ->Args({100000, 45, 25})
     ->Iterations(4)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(gas2)->Name("EdmGas2D")->Args({100000, 30})->Iterations(4)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(gas2)->Name("EdmGas2D")->Args({100000, 30, 0})->Iterations(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

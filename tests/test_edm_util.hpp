@@ -142,9 +142,10 @@ double maxWallPenetration(const World<D>& w) {
 namespace haet::testing {
 
 /// Compressibility factor Z = 1 + (sum r_ij . dp_i / t_w) / sum m v^2 (PHYSICS.md E.2) of an elastic smooth
-/// hard-sphere (disk) gas, measured over `collisions` collisions after `equilibrate` collisions per particle.
+/// hard-sphere (disk) gas, measured over `collisions` collisions after `equilibrate` collisions per particle;
+/// shell: EdmSettings::shell.
 template <int D>
-double measureZ(int n, double phi, std::uint64_t collisions, double equilibrate, std::uint64_t seed) {
+double measureZ(int n, double phi, std::uint64_t collisions, double equilibrate, std::uint64_t seed, double shell = 0) {
     GasSpec g;
     g.n = n;
     g.phi = phi;
@@ -152,6 +153,7 @@ double measureZ(int n, double phi, std::uint64_t collisions, double equilibrate,
     World<D> w = makeGas<D>(g, edmContact(1.0));
     EdmSettings s;
     s.tcModel = false;
+    s.shell = shell;
     EdmEngine<D> eng(w, s);
     double t = 0;
     while (eng.collisions() < equilibrate * n) eng.advanceTo(t += 0.5);

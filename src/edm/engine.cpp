@@ -46,10 +46,12 @@ EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings) : w_(world
     if (s_.tcTime < 0) throw std::invalid_argument("event-driven engine: tcTime must be >= 0");
     if (s_.maxEventRate < 0) throw std::invalid_argument("event-driven engine: maxEventRate must be >= 0");
     if (s_.cellSize < 0) throw std::invalid_argument("event-driven engine: cellSize must be >= 0");
+    if (!(s_.shell >= 0)) throw std::invalid_argument("event-driven engine: shell must be >= 0");
     tcRef_ = s_.tcTime > 0 ? s_.tcTime : cs.contactTime;
     tc_ = (s_.tcModel && tcRef_ > 0) ? tcRef_ : 0;
     g_ = w_.domain.gravity;
     boxLen_ = w_.domain.length();
+    for (int k = 0; k < D; ++k) periodic_ = periodic_ || w_.domain.periodic[k];
     for (std::size_t k = 0; k < w_.walls.size(); ++k) {
         const Wall<D>& wl = w_.walls[k];
         if (wl.material < 0 || wl.material >= cs.nMaterials)
@@ -107,6 +109,7 @@ void EdmEngine<D>::reset() {
     window_ = std::max<std::uint64_t>(1000000, 100 * static_cast<std::uint64_t>(nMoving_));
     winEvents_ = events_;
     winTime_ = w_.time;
+    chooseShell();
 
     // Slots in World order first, then sorted cell by cell.
     buildGrid();
@@ -128,7 +131,18 @@ void EdmEngine<D>::reset() {
     }
     nLive_ = n - first;
     queue_.reset(n);
+    if (shells_) {
+        // Shell centres where the particles are; the grid holds centres.
+        centre_.assign(n, Centre{Vec<D>::zero(), 0.0});
+        for (std::uint32_t i = static_cast<std::uint32_t>(first); i < n; ++i) {
+            centre_[i] = Centre{p.x[i], p.radius[i]};
+            rec_[i].cell = cellOf(p.x[i]);
+        }
+        nbr_.clear();
+        rowLen_ = 0;
+    }
     resort();  // also links the cells, numbers slotOf_ and free_
+    if (shells_) buildLists();
     if (zoned_) attachZones(zone_);
     if (s_.reference) return;
     for (std::uint32_t s = 0; s < n; ++s)
@@ -149,11 +163,21 @@ void EdmEngine<D>::wrapIntoBox(std::size_t i) {
     }
 }
 
+// Neighbour shells or cell crossings (EdmSettings::shell).
+template <int D>
+void EdmEngine<D>::chooseShell() {
+    shells_ = s_.shell > 0 && !s_.reference && w_.particles.size() <= kSlotMask && rmax_ > 0;
+    shellHalf_ = shells_ ? s_.shell * rmax_ : 0;  // half of shell * (2 rmax)
+}
+
 template <int D>
 void EdmEngine<D>::buildGrid() {
-    double edge = s_.cellSize > 0 ? s_.cellSize : 2 * rmax_;
-    if (s_.cellSize > 0 && s_.cellSize < 2 * rmax_ * (1 - 1e-12))
-        throw std::invalid_argument("event-driven engine: cellSize is smaller than the largest diameter");
+    const double least = 2 * rmax_ + (shells_ ? 2 * shellHalf_ : 0);
+    double edge = s_.cellSize > 0 ? s_.cellSize : least;
+    if (s_.cellSize > 0 && s_.cellSize < least * (1 - 1e-12))
+        throw std::invalid_argument(shells_ ? "event-driven engine: cellSize is smaller than the largest diameter "
+                                              "plus the neighbour shell"
+                                            : "event-driven engine: cellSize is smaller than the largest diameter");
     if (!(edge > 0)) edge = 1;
     // At most max(2^20, 8 N) cells: a huge open box with few particles gets larger cells.
     const double maxCells = std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size()));
@@ -254,6 +278,20 @@ void EdmEngine<D>::resort() {
     permute(hot_);
     permute(link_);
     permute(rec_);
+    if (shells_) {
+        permute(centre_);
+        if (!nbr_.empty()) {
+            std::vector<std::uint32_t> rows(nbr_.size());
+            for (std::size_t k = 0; k < n; ++k) {
+                const std::uint32_t* from = row(order[k]);
+                std::uint32_t* to = &rows[k * rowLen_];
+                to[0] = from[0];
+                for (std::uint32_t q = 1; q <= from[0]; ++q)
+                    to[q] = (from[q] & ~kSlotMask) | newSlot[from[q] & kSlotMask];
+            }
+            nbr_.swap(rows);
+        }
+    }
     std::vector<double> times(n);
     for (std::size_t k = 0; k < n; ++k) times[k] = queue_.time(order[k]);
     auto renumber = [&](std::uint32_t& code) {
@@ -374,12 +412,62 @@ double EdmEngine<D>::wallTime(std::uint32_t s, std::size_t w, double now) const 
     return now + wallCollisionTime(posAt(h, now), velAt(h, now), h.r, wl.pointAt(now), wl.velocity, wl.normal, g_);
 }
 
+// The canonical form of pairTime for moving slot s (state hs) and slot j seen through the image shift m, written
+// out for speed: the older of the two states is extrapolated to the other's clock (an extrapolation by zero leaves a
+// state unchanged, so skipping it gives the same bits). A candidate whose root cannot come before bestTime gives
+// kNever without the square root or the division. The same arithmetic as the cell scan in predict, which keeps its
+// own copy: written there with the image shift of the cell and gravity hoisted out of the loop, the cell scan took
+// 7 % fewer instructions (callgrind, 3D phi = 0.1 and 0.3).
+template <int D>
+inline double EdmEngine<D>::candidateTime(const Hot& hs, std::uint32_t s, std::uint32_t j, const Shift& m, double now,
+                                          double bestTime) const {
+    const Hot& hj = hot_[j];
+    if (hj.t == kNever) return pairTime(s, j, m, now, bestTime);
+    const double ts = hs.t;
+    double r[D], v[D], tr;
+    if (hj.t <= ts) {
+        tr = ts;
+        const double db = ts - hj.t;
+        for (int k = 0; k < D; ++k) {
+            const double xb = hj.x[k] + (hj.v[k] + 0.5 * g_[k] * db) * db;
+            r[k] = (hs.x[k] - xb) + m[k] * boxLen_[k];
+            v[k] = hs.v[k] - (hj.v[k] + g_[k] * db);
+        }
+    } else {
+        tr = hj.t;
+        const double da = hj.t - ts;
+        for (int k = 0; k < D; ++k) {
+            const double xa = hs.x[k] + (hs.v[k] + 0.5 * g_[k] * da) * da;
+            r[k] = (xa - hj.x[k]) + m[k] * boxLen_[k];
+            v[k] = (hs.v[k] + g_[k] * da) - hj.v[k];
+        }
+    }
+    double b = 0;
+    for (int k = 0; k < D; ++k) b += r[k] * v[k];
+    if (!(b < 0)) return kNever;
+    const double sigma = hs.r + hj.r;
+    double r2 = 0;
+    for (int k = 0; k < D; ++k) r2 += r[k] * r[k];
+    const double c = r2 - sigma * sigma;
+    // Lower bound of the root: c / (-2 b). Beyond the best event so far: no sqrt, no division.
+    const double left = bestTime - tr;
+    if (c > 0 && c > -2 * b * left * (1 + 1e-12)) return kNever;
+    double v2 = 0;
+    for (int k = 0; k < D; ++k) v2 += v[k] * v[k];
+    const double t = tr + firstRootFalling(c, 2 * b, 2 * v2);
+    return t < now ? pairTimeFromNow(s, j, m, now) : t;
+}
+
 // Predicts the next event of slot s at time now: the earliest of its cell exit, its wall collisions and its
 // collisions with the particles of the 3^D neighbour cells. After a cell crossing (axis >= 0, dir = +-1) with a
 // still valid earlier result in rec_[s].coll, only the newly adjacent cells are scanned: the others were scanned
 // before and their particles' trajectories are unchanged (a particle that changed since re-predicted itself).
 template <int D>
 void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
+    if (shells_) {
+        predictShell(s, now);
+        return;
+    }
     const Domain<D>& dom = w_.domain;
     const Hot& hs = hot_[s];
     const Shift ws = link_[s].wrap;
@@ -542,6 +630,236 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
     queue_.update(s, next.time);
 }
 
+// ---------------------------------------------------------------------------------------------------------------
+// neighbour shells (Donev, Torquato & Stillinger 2005; Smallenburg 2022), docs/edm.md
+//
+// Each particle has a centre (its box-frame position when its list was made) and stays within the cube of half-edge
+// h around it: leaving the cube is an event (the same per-axis exit times as a cell crossing, so gravity costs
+// nothing extra). Two particles can touch before either leaves its cube only if the cubes, widened by the sum of
+// the radii, meet: per axis the gap max(0, |c_i - c_j| - 2h), and the sum of the squared gaps at most the squared
+// sum of the radii. The lists hold exactly these pairs, in both particles' lists; a particle that leaves its cube
+// takes itself out of its neighbours' lists, takes a new centre and a new list from the grid of centres, and puts
+// itself into its new neighbours' lists. A collision is found by whichever of the two predicts after the pair
+// became listed: its prediction sees the other, as in the cell scheme.
+
+template <int D>
+template <class F>
+void EdmEngine<D>::forEachCellAround(std::uint32_t c, F&& f) const {
+    std::array<int, D> cc;
+    bool interior = true;
+    for (int k = 0; k < D; ++k) {
+        cc[k] = static_cast<int>((c / stride_[k]) % static_cast<std::uint32_t>(nCell_[k]));
+        interior = interior && cc[k] >= 1 && cc[k] <= nCell_[k] - 2;
+    }
+    if (interior) {
+        const Shift none{};
+        for (const std::int32_t dl : deltaFull_) f(c + static_cast<std::uint32_t>(dl), none);
+        return;
+    }
+    constexpr int m = D == 3 ? 27 : 9;
+    for (int code = 0; code < m; ++code) {
+        std::uint32_t idx = 0;
+        Shift image{};
+        bool ok = true;
+        int q = code;
+        for (int k = 0; k < D; ++k) {
+            int ck = cc[k] + q % 3 - 1;
+            q /= 3;
+            if (ck < 0 || ck >= nCell_[k]) {
+                if (!w_.domain.periodic[k]) {
+                    ok = false;
+                    break;
+                }
+                image[k] = ck < 0 ? -1 : 1;
+                ck -= image[k] * nCell_[k];
+            }
+            idx += static_cast<std::uint32_t>(ck) * stride_[k];
+        }
+        if (ok) f(idx, image);
+    }
+}
+
+namespace {
+/// Image code of a list entry: 2 bits per axis, image + 1 (image in -1, 0, 1).
+template <std::size_t D>
+std::uint32_t imageCode(const std::array<std::int32_t, D>& image, int sign) {
+    std::uint32_t code = 0;
+    for (std::size_t k = 0; k < D; ++k) code |= static_cast<std::uint32_t>(sign * image[k] + 1) << (2 * k);
+    return code;
+}
+/// The same entry as seen from the partner: every image negated.
+template <int D>
+std::uint32_t mirrorImage(std::uint32_t code) {
+    std::uint32_t out = 0;
+    for (int k = 0; k < D; ++k) out |= (2 - ((code >> (2 * k)) & 3u)) << (2 * k);
+    return out;
+}
+}  // namespace
+
+// Puts s into the lists of the particles whose shells its new shell meets, and them into its list.
+// false: a list is full (nothing is undone; the caller rebuilds every list with longer rows).
+template <int D>
+bool EdmEngine<D>::linkShell(std::uint32_t s) {
+    const Vec<D> cs = centre_[s].c;
+    const double rs = centre_[s].r, reach = 2 * shellHalf_;
+    bool ok = true;
+    forEachCellAround(rec_[s].cell, [&](std::uint32_t c, const Shift& image) {
+        for (std::uint32_t j = head_[c]; j != kNil && ok; j = link_[j].next) {
+            if (j == s) continue;
+            double gap2 = 0;
+            for (int k = 0; k < D; ++k) {
+                const double gap = std::abs(cs[k] - centre_[j].c[k] - image[k] * boxLen_[k]) - reach;
+                if (gap > 0) gap2 += gap * gap;
+            }
+            const double sigma = (rs + centre_[j].r) * (1 + 1e-9);
+            if (gap2 > sigma * sigma) continue;
+            std::uint32_t* a = row(s);
+            std::uint32_t* b = row(j);
+            if (a[0] + 1 >= rowLen_ || b[0] + 1 >= rowLen_) {
+                ok = false;
+                return;
+            }
+            a[++a[0]] = j | (imageCode<D>(image, 1) << kImageShift);
+            b[++b[0]] = s | (imageCode<D>(image, -1) << kImageShift);
+        }
+    });
+    return ok;
+}
+
+// Takes s out of its neighbours' lists and empties its own.
+template <int D>
+void EdmEngine<D>::unlinkShell(std::uint32_t s) {
+    std::uint32_t* a = row(s);
+    for (std::uint32_t q = 1; q <= a[0]; ++q) {
+        const std::uint32_t j = a[q] & kSlotMask;
+        const std::uint32_t mine = s | (mirrorImage<D>(a[q] >> kImageShift) << kImageShift);
+        std::uint32_t* b = row(j);
+        for (std::uint32_t u = 1; u <= b[0]; ++u) {
+            if (b[u] != mine) continue;
+            b[u] = b[b[0]--];
+            break;
+        }
+    }
+    a[0] = 0;
+}
+
+// Slot s leaves its shell at time now: a new centre (its box-frame position now, brought into the box on periodic
+// axes by changing its wrap count, which leaves its stored state alone) and a new list.
+template <int D>
+void EdmEngine<D>::moveShell(std::uint32_t s, double now) {
+    unlinkShell(s);
+    const Vec<D> x = posAt(hot_[s], now);
+    Shift& ws = link_[s].wrap;
+    Vec<D> c;
+    for (int k = 0; k < D; ++k) {
+        c[k] = x[k] - ws[k] * boxLen_[k];
+        const double lo = w_.domain.lo[k], L = boxLen_[k];
+        if (!w_.domain.periodic[k] || (c[k] >= lo && c[k] < lo + L)) continue;
+        ws[k] += static_cast<std::int32_t>(std::floor((c[k] - lo) / L));
+        c[k] = x[k] - ws[k] * boxLen_[k];
+    }
+    centre_[s].c = c;
+    const std::uint32_t cell = cellOf(c);
+    if (cell != rec_[s].cell) {
+        removeCell(s);
+        insertCell(s, cell);
+    }
+    if (!linkShell(s)) {
+        ++stats_.listGrowths;
+        buildLists();
+    }
+}
+
+// Every list from the centres: first the longest list, then rows with room to grow, then each row from its own scan
+// (the lists are symmetric, so no row needs another's).
+template <int D>
+void EdmEngine<D>::buildLists() {
+    const std::uint32_t n = static_cast<std::uint32_t>(hot_.size());
+    const double reach = 2 * shellHalf_;
+    auto scan = [&](std::uint32_t s, auto&& take) {
+        const Vec<D> cs = centre_[s].c;
+        const double rs = centre_[s].r;
+        forEachCellAround(rec_[s].cell, [&](std::uint32_t c, const Shift& image) {
+            for (std::uint32_t j = head_[c]; j != kNil; j = link_[j].next) {
+                if (j == s) continue;
+                double gap2 = 0;
+                for (int k = 0; k < D; ++k) {
+                    const double gap = std::abs(cs[k] - centre_[j].c[k] - image[k] * boxLen_[k]) - reach;
+                    if (gap > 0) gap2 += gap * gap;
+                }
+                const double sigma = (rs + centre_[j].r) * (1 + 1e-9);
+                if (gap2 <= sigma * sigma) take(j, image);
+            }
+        });
+    };
+    std::uint32_t longest = 0;
+    for (std::uint32_t s = 0; s < n; ++s) {
+        if (rec_[s].idx == kNil) continue;
+        std::uint32_t count = 0;
+        scan(s, [&](std::uint32_t, const Shift&) { ++count; });
+        longest = std::max(longest, count);
+    }
+    // Room for fluctuations: a list grows when a neighbour's new shell meets the particle's.
+    const std::size_t len = std::max<std::size_t>(rowLen_ + 4, longest + 5);
+    rowLen_ = (len + 3) / 4 * 4;
+    nbr_.assign(static_cast<std::size_t>(n) * rowLen_, 0);
+    for (std::uint32_t s = 0; s < n; ++s) {
+        if (rec_[s].idx == kNil) continue;
+        std::uint32_t* a = row(s);
+        scan(s, [&](std::uint32_t j, const Shift& image) { a[++a[0]] = j | (imageCode<D>(image, 1) << kImageShift); });
+    }
+}
+
+// Next event of slot s with neighbour shells: its shell exit, its walls, the particles of its list.
+template <int D>
+void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
+    const Hot& hs = hot_[s];
+    const std::uint32_t* a = row(s);
+    const std::uint32_t count = a[0];
+    for (std::uint32_t q = 1; q <= count; ++q) {
+        __builtin_prefetch(&hot_[a[q] & kSlotMask]);
+        if (periodic_) __builtin_prefetch(&link_[a[q] & kSlotMask]);
+    }
+    const Shift ws = link_[s].wrap;
+    const Vec<D> xNow = posAt(hs, now), vNow = velAt(hs, now);
+    const Vec<D>& c = centre_[s].c;
+    Candidate cross;
+    for (int k = 0; k < D; ++k) {
+        const CellExit ex =
+            cellExitTime(xNow[k] - ws[k] * boxLen_[k], vNow[k], g_[k], c[k] - shellHalf_, c[k] + shellHalf_);
+        const double t = now + ex.time;
+        const std::uint32_t code = (kCell << kTypeShift) | static_cast<std::uint32_t>(2 * k + (ex.up ? 1 : 0));
+        if (cross.better(t, code)) cross = {t, code, 0};
+    }
+    Candidate best;
+    for (std::size_t w = 0; w < w_.walls.size(); ++w) {
+        const double t = wallTime(s, w, now);
+        const std::uint32_t code = (kWall << kTypeShift) | static_cast<std::uint32_t>(w);
+        if (best.better(t, code)) best = {t, code, 0};
+    }
+    std::uint32_t bestJ = kNil;
+    for (std::uint32_t q = 1; q <= count; ++q) {
+        const std::uint32_t j = a[q] & kSlotMask;
+        Shift m{};
+        if (periodic_) {
+            const std::uint32_t image = a[q] >> kImageShift;
+            const Shift& wj = link_[j].wrap;
+            for (int k = 0; k < D; ++k) m[k] = wj[k] - ws[k] - (static_cast<std::int32_t>((image >> (2 * k)) & 3u) - 1);
+        }
+        const double t = candidateTime(hs, s, j, m, now, best.time);
+        const std::uint32_t code = (kPair << kTypeShift) | j;
+        if (best.better(t, code)) {
+            best = {t, code, 0};
+            bestJ = j;
+        }
+    }
+    if (bestJ != kNil) best.stamp = link_[bestJ].count;
+    rec_[s].coll = best;
+    const Candidate& next = cross.better(best.time, best.code) ? best : cross;
+    rec_[s].evCode = next.code;
+    queue_.update(s, next.time);
+}
+
 template <int D>
 void EdmEngine<D>::crossCell(std::uint32_t s, int axis, bool up) {
     const int c = static_cast<int>((rec_[s].cell / stride_[axis]) % static_cast<std::uint32_t>(nCell_[axis]));
@@ -645,7 +963,8 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     advance(b, t);
     const bool elastic = tcElastic(a, fb ? kNil : b, t);
     bool hop = false;
-    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(p.material[i], p.material[j], elastic), approaching, gn, uRest, hop);
+    const Vec<D> P =
+        impulseWithHop(b1, b2, n, lawFor(p.material[i], p.material[j], elastic), approaching, gn, uRest, hop);
     const double before = kineticEnergy(b1) + kineticEnergy(b2);
     applyImpulse(b1, b2, n, P);
     stats_.dissipated += before - kineticEnergy(b1) - kineticEnergy(b2);
@@ -750,6 +1069,12 @@ void EdmEngine<D>::processNext() {
             predict(s, t);
             return;
         case kCell: {
+            if (shells_) {
+                ++stats_.shellExits;
+                moveShell(s, t);
+                predictShell(s, t);
+                return;
+            }
             ++stats_.cellCrossings;
             const int axis = static_cast<int>(k >> 1);
             const bool up = k & 1;
@@ -895,6 +1220,7 @@ void EdmEngine<D>::remove(std::size_t i, double t) {
     const std::uint32_t s = slotOf_[i];
     const bool fz = frozen(s);
     if (!fz) syncSlot(s, t);
+    if (shells_) unlinkShell(s);
     removeCell(s);
     if (zoned_) zoneVolume_[zoneOfCell(rec_[s].cell)] -= Particles<D>::volumeOf(hot_[s].r);
     ++link_[s].count;  // events of others that name s are stale now
@@ -931,9 +1257,26 @@ void EdmEngine<D>::add(std::size_t i, double t) {
     if (zoned_) zoneVolume_[zoneOfCell(rec_[s].cell)] += Particles<D>::volumeOf(hot_[s].r);
     slotOf_[i] = s;
     ++nLive_;
+    if (shells_) {
+        centre_[s] = Centre{p.x[i], p.radius[i]};
+        if (!linkShell(s)) {
+            ++stats_.listGrowths;
+            buildLists();
+        }
+    }
     if (!fz) {
         ++nMoving_;
         predict(s, t);
+        return;
+    }
+    if (shells_) {  // a new obstacle: the moving particles of its list re-predict (their events did not know it)
+        std::vector<std::uint32_t> around;
+        const std::uint32_t* a = row(s);
+        for (std::uint32_t q = 1; q <= a[0]; ++q)
+            if (!frozen(a[q] & kSlotMask)) around.push_back(a[q] & kSlotMask);
+        std::sort(around.begin(), around.end());
+        around.erase(std::unique(around.begin(), around.end()), around.end());
+        for (const std::uint32_t j : around) predict(j, t);
         return;
     }
     // A new obstacle: the moving particles around it re-predict (their events did not know it).
@@ -967,6 +1310,7 @@ std::uint32_t EdmEngine<D>::zoneOfCell(std::uint32_t c) const {
 
 template <int D>
 void EdmEngine<D>::attachZones(const EdmZoneLink<D>& link) {
+    if (shells_) throw std::logic_error("event-driven engine: zones need cell crossings (EdmSettings::shell = 0)");
     if (link.guard == nullptr || link.guard->size() != head_.size())
         throw std::invalid_argument("event-driven engine: the guard must have one entry per cell");
     for (int k = 0; k < D; ++k)
@@ -1022,7 +1366,7 @@ template <int D>
 std::size_t EdmEngine<D>::memoryBytes() const {
     auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
     return bytes(hot_) + bytes(link_) + bytes(rec_) + queue_.memoryBytes() + bytes(head_) + bytes(slotOf_) +
-           bytes(free_) + bytes(zoneVolume_);
+           bytes(free_) + bytes(zoneVolume_) + bytes(centre_) + bytes(nbr_);
 }
 
 template class EdmEngine<2>;

@@ -1,6 +1,7 @@
 #pragma once
 // Event-driven engine for hard disks (D = 2) and spheres (D = 3): Lubachevsky's scheme (PHYSICS.md D.1) with
-// one pending event per particle, collision counters for stale events, per-particle clocks (lazy updates), a
+// one pending event per particle, collision counters for stale events, per-particle clocks (lazy updates),
+// neighbour shells (a list per particle of those it can reach while it stays near where the list was made) or a
 // cell grid with cell-crossing events, periodic images, moving plane walls, gravity, frozen particles, the
 // rough-particle collision operator with Walton's rule (C), and the TC model against inelastic collapse (D.7).
 // docs/edm.md describes the algorithm, the invalid-state rules and the defaults.
@@ -18,8 +19,15 @@
 namespace haet {
 
 struct EdmSettings {
-    /// Edge of the event grid's cells [m]; 0: the largest particle diameter. Must not be smaller than that.
+    /// Edge of the event grid's cells [m]; 0: the largest particle diameter (with neighbour shells: plus the
+    /// shell). Must not be smaller than that.
     double cellSize = 0;
+    /// Neighbour shells (docs/edm.md), thickness [in units of the largest diameter]: each particle keeps a list
+    /// of the particles it can touch while it stays within half the thickness (per axis) of where its list was
+    /// made, and leaving that cube is its only non-collision event. 0: cell-crossing events (attachZones needs
+    /// them). Shells save instructions in dense states (phi >= 0.4 in 3D: 0.25) but not cache misses, so they
+    /// pay only when the engine's arrays fit in the cache (measured in docs/edm.md).
+    double shell = 0;
     /// Tangential restitution: Walton's rule with (e, mu, beta0) of the material pair, or beta = beta0 always.
     enum class Tangential { Walton, Constant } tangential = Tangential::Walton;
     /// TC model (PHYSICS.md A.4, D.7): a collision less than tcTime after the previous collision of either
@@ -72,6 +80,8 @@ struct EdmZoneLink {
 struct EdmStats {
     std::uint64_t pairCollisions = 0, wallCollisions = 0;
     std::uint64_t cellCrossings = 0;  ///< cell-crossing events
+    std::uint64_t shellExits = 0;     ///< neighbour-shell exits (list rebuilt)
+    std::uint64_t listGrowths = 0;    ///< neighbour lists enlarged (a list was full)
     std::uint64_t stale = 0;          ///< events found invalid (partner collided since) and re-predicted
     std::uint64_t tcElastic = 0;      ///< collisions made elastic by the TC model
     std::uint64_t restHops = 0;       ///< collisions whose normal speed was raised to the rest-hop speed
@@ -109,7 +119,7 @@ public:
     void add(std::size_t i, double t);
     /// The World exchanged particles i and j (Particles::swapEntries); owned or not.
     void swapIndices(std::size_t i, std::size_t j);
-    /// Hybrid coupling: zone volumes and the guard (EdmZoneLink).
+    /// Hybrid coupling: zone volumes and the guard (EdmZoneLink). Needs cell crossings (EdmSettings::shell = 0).
     void attachZones(const EdmZoneLink<D>& link);
     /// Per zone: volume of this engine's particles in it [m^D] (attachZones first).
     const std::vector<double>& zoneVolume() const { return zoneVolume_; }
@@ -182,8 +192,10 @@ public:
     const EdmSettings& settings() const { return s_; }
     double tcTime() const { return tc_; }  ///< the TC time in use [s] (0: TC model off)
     double cellSize() const;               ///< smallest cell edge of the grid [m]
-    double nextEventTime() const;          ///< time of the next pending event [s] (reference mode: infinity)
-    std::size_t memoryBytes() const;       ///< heap memory of the engine's own arrays [bytes]
+    /// Thickness of the neighbour shells in use [m] (0: cell crossings).
+    double shellThickness() const { return shells_ ? 2 * shellHalf_ : 0; }
+    double nextEventTime() const;     ///< time of the next pending event [s] (reference mode: infinity)
+    std::size_t memoryBytes() const;  ///< heap memory of the engine's own arrays [bytes]
 
 private:
     enum Type : std::uint32_t { kPair = 0, kWall = 1, kCell = 2, kNone = 3 };
@@ -212,6 +224,7 @@ private:
         bool better(double t, std::uint32_t c) const { return t < time || (t == time && c < code); }
     };
 
+    void chooseShell();
     void buildGrid();
     /// World particle i into the box on periodic axes (wraps recorded in Particles::image).
     void wrapIntoBox(std::size_t i);
@@ -221,6 +234,17 @@ private:
     void removeCell(std::uint32_t s);
     void resort();
     void predict(std::uint32_t s, double now, int axis = -1, int dir = 0);
+    void predictShell(std::uint32_t s, double now);
+    double candidateTime(const Hot& hs, std::uint32_t s, std::uint32_t j, const Shift& m, double now,
+                         double bestTime) const;
+    template <class F>
+    void forEachCellAround(std::uint32_t c, F&& f) const;
+    bool linkShell(std::uint32_t s);
+    void unlinkShell(std::uint32_t s);
+    void moveShell(std::uint32_t s, double now);
+    void buildLists();
+    std::uint32_t* row(std::uint32_t s) { return &nbr_[static_cast<std::size_t>(s) * rowLen_]; }
+    const std::uint32_t* row(std::uint32_t s) const { return &nbr_[static_cast<std::size_t>(s) * rowLen_]; }
     double pairTime(std::uint32_t a, std::uint32_t b, const Shift& m, double now, double horizon) const;
     double pairTimeFromNow(std::uint32_t a, std::uint32_t b, const Shift& m, double now) const;
     double wallTime(std::uint32_t s, std::size_t w, double now) const;
@@ -271,6 +295,21 @@ private:
     std::array<int, D> nCell_{};
     std::array<std::uint32_t, D> stride_{};
     Vec<D> cellW_;
+
+    // Neighbour shells (shells_): per slot the box-frame centre of its cube (edge 2 shellHalf_) and a row of rowLen_
+    // words in nbr_: the count, then the neighbours, each a slot with the periodic image of the neighbour's centre
+    // (kImageShift). The grid holds the centres; its cells are at least a diameter plus the shell wide.
+    static constexpr std::uint32_t kImageShift = 26, kSlotMask = (1u << kImageShift) - 1;
+    bool shells_ = false;
+    bool periodic_ = false;  // some axis is periodic
+    double shellHalf_ = 0;
+    struct alignas(32) Centre {
+        Vec<D> c;  // box-frame centre of the shell [m]
+        double r;  // radius [m], a copy of Hot::r: a list rebuild reads one record per candidate
+    };
+    std::vector<Centre> centre_;
+    std::vector<std::uint32_t> nbr_;
+    std::size_t rowLen_ = 0;
 
     // particles joining and leaving: World index -> slot (kNil: not owned), free slots (rec_[s].idx == kNil)
     std::vector<std::uint32_t> slotOf_;

@@ -21,8 +21,8 @@ void record(const std::string& key, double value) {
 
 // ---- equation of state: Z from the collision virial against Carnahan-Starling within 1.5 % (PHYSICS.md E.1) ----
 
-void zAgainstCarnahanStarling(double phi) {
-    const double z = testing::measureZ<3>(1000, phi, 2000000, 50, 21);
+void zAgainstCarnahanStarling(double phi, double shell = 0) {
+    const double z = testing::measureZ<3>(1000, phi, 2000000, 50, 21, shell);
     const double cs = testing::carnahanStarling(phi);
     record("Z", z);
     record("Z_CS", cs);
@@ -31,11 +31,12 @@ void zAgainstCarnahanStarling(double phi) {
 
 TEST(EdmValidate, CompressibilityFactorPhi01) { zAgainstCarnahanStarling(0.1); }
 TEST(EdmValidate, CompressibilityFactorPhi03) { zAgainstCarnahanStarling(0.3); }
+TEST(EdmValidate, CompressibilityFactorPhi045Shells) { zAgainstCarnahanStarling(0.45, 0.25); }
 
 // ---- elastic gas: total energy conserved to round-off over 10^6 collisions ----
 
 template <int D>
-void elasticEnergy(bool rough) {
+void elasticEnergy(bool rough, double shell = 0) {
     testing::GasSpec g;
     g.n = D == 3 ? 2000 : 1600;
     g.phi = D == 3 ? 0.25 : 0.5;
@@ -44,6 +45,7 @@ void elasticEnergy(bool rough) {
     World<D> w = testing::makeGas<D>(g, testing::edmContact(1.0, 0.0, rough ? 1.0 : -1.0));
     EdmSettings s;
     s.tangential = EdmSettings::Tangential::Constant;
+    s.shell = shell;
     EdmEngine<D> eng(w, s);
     const double e0 = testing::kineticEnergyEdm(w.particles);
     double worst = 0, t = 0;
@@ -58,6 +60,7 @@ void elasticEnergy(bool rough) {
 
 TEST(EdmValidate, ElasticSmoothGasConservesEnergy3D) { elasticEnergy<3>(false); }
 TEST(EdmValidate, ElasticRoughGasConservesEnergy2D) { elasticEnergy<2>(true); }
+TEST(EdmValidate, ElasticSmoothGasConservesEnergy3DShells) { elasticEnergy<3>(false, 0.25); }
 
 // ---- a dissipative heap of 2000 spheres (e = 0.5) poured into a box: bounded wall time, no overlap, none lost ----
 
@@ -104,25 +107,30 @@ TEST(EdmValidate, MatchesReferenceLongRun) {
     w.walls.push_back({Vec<3>::filled(L), Vec<3>{{0, 0, -1}}, Vec<3>{{0, 0, -0.01}}, 0});  // a slowly moving lid
     EdmSettings s;
     s.tcTime = 1e-3;
-    auto run = [&](bool reference, std::vector<EdmCollision<3>>& log) {
+    auto run = [&](bool reference, double shell, std::vector<EdmCollision<3>>& log) {
         World<3> copy = w;
         EdmSettings rs = s;
         rs.reference = reference;
+        rs.shell = shell;
         EdmEngine<3> eng(copy, rs);
         eng.setObserver([&](const EdmCollision<3>& c) { log.push_back(c); });
         eng.advanceTo(12.0);
     };
-    std::vector<EdmCollision<3>> fast, ref;
-    run(false, fast);
-    run(true, ref);
+    std::vector<EdmCollision<3>> ref;
+    run(true, 0, ref);
     record("collisions", static_cast<double>(ref.size()));
     ASSERT_GT(ref.size(), 50000u);
-    ASSERT_EQ(fast.size(), ref.size());
-    for (std::size_t k = 0; k < ref.size(); ++k) {
-        ASSERT_EQ(fast[k].wall, ref[k].wall) << k;
-        ASSERT_EQ(std::min(fast[k].i, fast[k].partner), std::min(ref[k].i, ref[k].partner)) << k;
-        ASSERT_EQ(std::max(fast[k].i, fast[k].partner), std::max(ref[k].i, ref[k].partner)) << k;
-        ASSERT_EQ(fast[k].time, ref[k].time) << k;
+    for (const double shell : {0.0, 0.25}) {  // cell crossings, neighbour shells
+        SCOPED_TRACE(shell);
+        std::vector<EdmCollision<3>> fast;
+        run(false, shell, fast);
+        ASSERT_EQ(fast.size(), ref.size());
+        for (std::size_t k = 0; k < ref.size(); ++k) {
+            ASSERT_EQ(fast[k].wall, ref[k].wall) << k;
+            ASSERT_EQ(std::min(fast[k].i, fast[k].partner), std::min(ref[k].i, ref[k].partner)) << k;
+            ASSERT_EQ(std::max(fast[k].i, fast[k].partner), std::max(ref[k].i, ref[k].partner)) << k;
+            ASSERT_EQ(fast[k].time, ref[k].time) << k;
+        }
     }
 }
 
