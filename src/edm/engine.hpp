@@ -131,6 +131,8 @@ public:
     std::vector<std::uint32_t> takeTcHandovers();
     /// Position of owned particle i at time t (>= its clock), wrapped into the box [m].
     Vec<D> positionAt(std::size_t i, double t) const;
+    /// Collisions of owned particle i so far (pair and wall; changes whenever its velocity jumps) [-].
+    std::uint32_t collisionCount(std::size_t i) const { return link_[slotOf_[i]].count; }
     /// Velocity of owned particle i at time t [m/s].
     Vec<D> velocityAt(std::size_t i, double t) const { return velAt(hot_[slotOf_[i]], t); }
     /// Guard value of the cell particle i is in.

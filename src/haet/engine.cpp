@@ -85,6 +85,7 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
     tdm_ = std::make_unique<TdmEngine<D>>(w_, ts_);
     margin_ = std::max(ts_.skin, 0.1 * rmax);
     rmax_ = rmax;
+    quiet_.assign(n, Quiet{});
 
     // Energy baselines, then the first relabel (guard, stragglers).
     for (std::size_t i = 0; i < n; ++i) e0_ += particleEnergy(i);
@@ -250,9 +251,17 @@ void HaetEngine<D>::buildNearGrid() {
 // Positions outside the near grid on an open axis fall into its outer cells, bins and queries alike: clamping
 // never separates two points less than a cell apart by more than one cell.
 template <int D>
-double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r) const {
+double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r, double* bound) const {
     double gap = kNever;
+    if (bound) *bound = 0;
     if (!near_.valid) return gap;
+    // Every bin outside the 3^D cells around x is at least a cell width away on some axis.
+    double lowest = kNever;
+    if (bound) {
+        double width = kNever;
+        for (int k = 0; k < D; ++k) width = std::min(width, 1 / near_.invWidth[k]);
+        lowest = width - r - rmax_;
+    }
     const Vec<D> L = w_.domain.length();
     const std::array<int, D> c = nearCoord(x);
     constexpr int m = D == 2 ? 9 : 27;
@@ -280,8 +289,10 @@ double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r) const {
                 if (w_.domain.periodic[k]) d[k] -= std::nearbyint(d[k] / L[k]) * L[k];
             const double reach = r + bins_[b].r + margin_, d2 = norm2(d);
             if (d2 < reach * reach && d2 > 0) gap = std::min(gap, std::sqrt(d2) - r - bins_[b].r);
+            if (bound && d2 > 0) lowest = std::min(lowest, std::sqrt(d2) - r - bins_[b].r);
         }
     }
+    if (bound) *bound = lowest;
     return gap;
 }
 
@@ -289,27 +300,47 @@ double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r) const {
 // zone; before the next due step only if they could touch a TDM particle before it.
 template <int D>
 void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals, bool due) {
-    std::sort(watch_.begin(), watch_.end());
+    // watch_[0, watchSorted_) is sorted and unique; what came since is sorted and merged in.
+    const auto mid = watch_.begin() + static_cast<std::ptrdiff_t>(std::min(watchSorted_, watch_.size()));
+    std::sort(mid, watch_.end());
+    std::inplace_merge(watch_.begin(), mid, watch_.end());
     watch_.erase(std::unique(watch_.begin(), watch_.end()), watch_.end());
     const std::uint64_t R = static_cast<std::uint64_t>(hs_.relabelEvery);
     const double horizon = ts_.dt * static_cast<double>(R - steps_ % R + 1);
+    const double g = norm(w_.domain.gravity);
     std::size_t keep = 0;
     for (const std::uint32_t i : watch_) {
         if (!edm_->owns(i)) continue;
         const std::uint8_t level = guard_[edm_->cellOfParticle(i)] & 3;
         if (level == 0) continue;
-        const double gap = gapToTdm(edm_->positionAt(i, w_.time), w_.particles.radius[i]);
+        // Near a TDM particle only: skipped while it provably stays beyond the margin (below).
+        const Quiet& q = quiet_[i];
+        if (level == 1 && q.epoch == binsEpoch_ && w_.time < q.until && q.collisions == edm_->collisionCount(i)) {
+            watch_[keep++] = i;
+            continue;
+        }
+        double bound;
+        const double gap = gapToTdm(edm_->positionAt(i, w_.time), w_.particles.radius[i], &bound);
+        const double speed = norm(edm_->velocityAt(i, w_.time));
         if (level >= 2 || gap < margin_) {
-            const double reach = (norm(edm_->velocityAt(i, w_.time)) + vTdmMax_) * horizon;
+            const double reach = (speed + vTdmMax_) * horizon;
             if (due || gap < reach) {
                 arrivals.push_back(i);
                 if (level < 2) ++counters_.nearTdm;
                 continue;
             }
+        } else {
+            // The bins stay put until the next relabel or hand-over (a new epoch), and the particle flies
+            // ballistically until it collides (its collision count changes): its gap to them cannot fall below the
+            // margin sooner than tau, when speed tau + g tau^2 / 2 = bound - margin.
+            const double room = bound - margin_;
+            const double tau = room > 0 ? 2 * room / (speed + std::sqrt(speed * speed + 2 * g * room)) : 0.0;
+            quiet_[i] = Quiet{w_.time + tau, edm_->collisionCount(i), binsEpoch_};
         }
         watch_[keep++] = i;
     }
     watch_.resize(keep);
+    watchSorted_ = keep;
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -359,6 +390,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
     }
     bins_.clear();
     near_.valid = false;
+    ++binsEpoch_;
     std::vector<std::uint32_t> candidates;
     for (std::size_t i = 0; i < nT; ++i) {
         const std::uint64_t last = due ? lastTdmStep_[zoneOf[i]] : steps_;
@@ -476,6 +508,7 @@ void HaetEngine<D>::convert(std::vector<std::uint32_t> arrivals, std::vector<std
         if (a == b) return;
         p.swapEntries(a, b);
         edm_->swapIndices(a, b);
+        std::swap(quiet_[a], quiet_[b]);
         auto oa = origin.find(a), ob = origin.find(b);
         const std::uint32_t ia = oa != origin.end() ? oa->second : a, ib = ob != origin.end() ? ob->second : b;
         origin[a] = ib;
@@ -516,8 +549,10 @@ void HaetEngine<D>::convert(std::vector<std::uint32_t> arrivals, std::vector<std
             auto f = now.find(i);
             if (f != now.end()) i = f->second;
         }
+        watchSorted_ = 0;  // renumbered: sorted anew at the next check
     }
     tdm_->remap(from);
+    ++binsEpoch_;
     // The new TDM particles guard their surroundings until the next relabel.
     for (std::size_t k = 0; k < nT; ++k) {
         if (from[k] != TdmEngine<D>::kFresh) continue;

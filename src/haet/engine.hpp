@@ -118,7 +118,8 @@ private:
     void markAround(std::uint32_t cell, std::uint8_t level);
     /// Smallest gap between a sphere (x, r) and the binned TDM particles within the margin (one at x itself
     /// excluded); infinity if none.
-    double gapToTdm(const Vec<D>& x, double r) const;
+    /// bound (if given): a lower bound of the gap to every binned TDM particle, also those beyond the margin.
+    double gapToTdm(const Vec<D>& x, double r, double* bound = nullptr) const;
     double particleEnergy(std::size_t i) const;
     double tdmEnergy() const;
 
@@ -137,6 +138,16 @@ private:
     NearGrid near_;
     double rmax_ = 0;
     std::vector<std::uint32_t> watch_;               // event-driven particles in guard cells (World indices)
+    std::size_t watchSorted_ = 0;                    // watch_[0, watchSorted_) is sorted and unique
+    // A watched particle whose gap to the bins cannot reach the margin before `until` (World index; valid while
+    // the bins' epoch and the particle's collision count are unchanged).
+    struct Quiet {
+        double until = 0;
+        std::uint32_t collisions = 0;
+        std::uint64_t epoch = 0;
+    };
+    std::vector<Quiet> quiet_;
+    std::uint64_t binsEpoch_ = 1;
     std::array<std::vector<std::uint32_t>, D> zoneCellBegin_;  // per axis and zone coordinate: first cell coordinate
     std::vector<std::uint64_t> lastTdmStep_;  // per zone: last step it was time-driven
     std::vector<std::uint64_t> denseUntil_;   // per zone: kept dense until this step (modified EDM hand-over)
