@@ -642,43 +642,6 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
 // itself into its new neighbours' lists. A collision is found by whichever of the two predicts after the pair
 // became listed: its prediction sees the other, as in the cell scheme.
 
-template <int D>
-template <class F>
-void EdmEngine<D>::forEachCellAround(std::uint32_t c, F&& f) const {
-    std::array<int, D> cc;
-    bool interior = true;
-    for (int k = 0; k < D; ++k) {
-        cc[k] = static_cast<int>((c / stride_[k]) % static_cast<std::uint32_t>(nCell_[k]));
-        interior = interior && cc[k] >= 1 && cc[k] <= nCell_[k] - 2;
-    }
-    if (interior) {
-        const Shift none{};
-        for (const std::int32_t dl : deltaFull_) f(c + static_cast<std::uint32_t>(dl), none);
-        return;
-    }
-    constexpr int m = D == 3 ? 27 : 9;
-    for (int code = 0; code < m; ++code) {
-        std::uint32_t idx = 0;
-        Shift image{};
-        bool ok = true;
-        int q = code;
-        for (int k = 0; k < D; ++k) {
-            int ck = cc[k] + q % 3 - 1;
-            q /= 3;
-            if (ck < 0 || ck >= nCell_[k]) {
-                if (!w_.domain.periodic[k]) {
-                    ok = false;
-                    break;
-                }
-                image[k] = ck < 0 ? -1 : 1;
-                ck -= image[k] * nCell_[k];
-            }
-            idx += static_cast<std::uint32_t>(ck) * stride_[k];
-        }
-        if (ok) f(idx, image);
-    }
-}
-
 namespace {
 /// Image code of a list entry: 2 bits per axis, image + 1 (image in -1, 0, 1).
 template <std::size_t D>
@@ -697,22 +660,27 @@ std::uint32_t mirrorImage(std::uint32_t code) {
 }  // namespace
 
 // Puts s into the lists of the particles whose shells its new shell meets, and them into its list.
+// Whether particles s and j (image `image` of j) can touch while each stays in its cube: the two cubes, grown by
+// the radii, overlap.
+template <int D>
+bool EdmEngine<D>::shellsMeet(std::uint32_t s, std::uint32_t j, const Shift& image) const {
+    const double reach = 2 * shellHalf_;
+    double gap2 = 0;
+    for (int k = 0; k < D; ++k) {
+        const double gap = std::abs(centre_[s].c[k] - centre_[j].c[k] - image[k] * boxLen_[k]) - reach;
+        if (gap > 0) gap2 += gap * gap;
+    }
+    const double sigma = (centre_[s].r + centre_[j].r) * (1 + 1e-9);
+    return gap2 <= sigma * sigma;
+}
+
 // false: a list is full (nothing is undone; the caller rebuilds every list with longer rows).
 template <int D>
 bool EdmEngine<D>::linkShell(std::uint32_t s) {
-    const Vec<D> cs = centre_[s].c;
-    const double rs = centre_[s].r, reach = 2 * shellHalf_;
     bool ok = true;
     forEachCellAround(rec_[s].cell, [&](std::uint32_t c, const Shift& image) {
         for (std::uint32_t j = head_[c]; j != kNil && ok; j = link_[j].next) {
-            if (j == s) continue;
-            double gap2 = 0;
-            for (int k = 0; k < D; ++k) {
-                const double gap = std::abs(cs[k] - centre_[j].c[k] - image[k] * boxLen_[k]) - reach;
-                if (gap > 0) gap2 += gap * gap;
-            }
-            const double sigma = (rs + centre_[j].r) * (1 + 1e-9);
-            if (gap2 > sigma * sigma) continue;
+            if (j == s || !shellsMeet(s, j, image)) continue;
             std::uint32_t* a = row(s);
             std::uint32_t* b = row(j);
             if (a[0] + 1 >= rowLen_ || b[0] + 1 >= rowLen_) {
@@ -775,21 +743,10 @@ void EdmEngine<D>::moveShell(std::uint32_t s, double now) {
 template <int D>
 void EdmEngine<D>::buildLists() {
     const std::uint32_t n = static_cast<std::uint32_t>(hot_.size());
-    const double reach = 2 * shellHalf_;
     auto scan = [&](std::uint32_t s, auto&& take) {
-        const Vec<D> cs = centre_[s].c;
-        const double rs = centre_[s].r;
         forEachCellAround(rec_[s].cell, [&](std::uint32_t c, const Shift& image) {
-            for (std::uint32_t j = head_[c]; j != kNil; j = link_[j].next) {
-                if (j == s) continue;
-                double gap2 = 0;
-                for (int k = 0; k < D; ++k) {
-                    const double gap = std::abs(cs[k] - centre_[j].c[k] - image[k] * boxLen_[k]) - reach;
-                    if (gap > 0) gap2 += gap * gap;
-                }
-                const double sigma = (rs + centre_[j].r) * (1 + 1e-9);
-                if (gap2 <= sigma * sigma) take(j, image);
-            }
+            for (std::uint32_t j = head_[c]; j != kNil; j = link_[j].next)
+                if (j != s && shellsMeet(s, j, image)) take(j, image);
         });
     };
     std::uint32_t longest = 0;

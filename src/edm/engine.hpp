@@ -142,15 +142,25 @@ public:
     std::uint32_t cellCount() const { return static_cast<std::uint32_t>(head_.size()); }
     const std::array<int, D>& cellDims() const { return nCell_; }
     const Vec<D>& cellWidths() const { return cellW_; }
-    /// Calls f(cell index) for cell c and its 3^D - 1 neighbours (periodic axes wrap, open ones end; on a periodic
-    /// axis of fewer than 3 cells a cell can come twice).
+    /// Calls f(cell index, image) for cell c and its 3^D - 1 neighbours: periodic axes wrap (image: -1 or +1 box
+    /// lengths on the axes crossed), open ones end; on a periodic axis of fewer than 3 cells a cell can come twice.
     template <class F>
-    void forEachNeighbourCell(std::uint32_t c, F&& f) const {
+    void forEachCellAround(std::uint32_t c, F&& f) const {
         std::array<int, D> cc;
-        for (int k = 0; k < D; ++k) cc[k] = static_cast<int>((c / stride_[k]) % static_cast<std::uint32_t>(nCell_[k]));
+        bool interior = true;
+        for (int k = 0; k < D; ++k) {
+            cc[k] = static_cast<int>((c / stride_[k]) % static_cast<std::uint32_t>(nCell_[k]));
+            interior = interior && cc[k] >= 1 && cc[k] <= nCell_[k] - 2;
+        }
+        if (interior) {
+            const Shift none{};
+            for (const std::int32_t dl : deltaFull_) f(c + static_cast<std::uint32_t>(dl), none);
+            return;
+        }
         constexpr int m = D == 3 ? 27 : 9;
         for (int code = 0; code < m; ++code) {
             std::uint32_t idx = 0;
+            Shift image{};
             bool ok = true;
             int q = code;
             for (int k = 0; k < D; ++k) {
@@ -161,12 +171,18 @@ public:
                         ok = false;
                         break;
                     }
-                    ck = (ck + nCell_[k]) % nCell_[k];
+                    image[k] = ck < 0 ? -1 : 1;
+                    ck -= image[k] * nCell_[k];
                 }
                 idx += static_cast<std::uint32_t>(ck) * stride_[k];
             }
-            if (ok) f(idx);
+            if (ok) f(idx, image);
         }
+    }
+    /// The same without the images: f(cell index).
+    template <class F>
+    void forEachNeighbourCell(std::uint32_t c, F&& f) const {
+        forEachCellAround(c, [&](std::uint32_t idx, const Shift&) { f(idx); });
     }
     /// Calls f(World index) for every particle of this engine in cell c.
     template <class F>
@@ -239,8 +255,7 @@ private:
     void predictShell(std::uint32_t s, double now);
     double candidateTime(const Hot& hs, std::uint32_t s, std::uint32_t j, const Shift& m, double now,
                          double bestTime) const;
-    template <class F>
-    void forEachCellAround(std::uint32_t c, F&& f) const;
+    bool shellsMeet(std::uint32_t s, std::uint32_t j, const Shift& image) const;
     bool linkShell(std::uint32_t s);
     void unlinkShell(std::uint32_t s);
     void moveShell(std::uint32_t s, double now);
