@@ -34,6 +34,18 @@ struct PolygonScratch {
 };
 
 
+/// Particle i as a body of the contact law (BodyState::x left at zero: the caller sets the frame).
+inline BodyState bodyOf(const Particles<2>& p, const V2* sv, const Ang<2>* sw, std::size_t i) {
+    BodyState b;
+    b.v = p.v[i];
+    b.w = p.w[i][0];
+    b.vStep = sv[i];
+    b.wStep = sw[i][0];
+    b.invMass = p.invMass[i];
+    b.invInertia = p.invInertia[i];
+    return b;
+}
+
 /// Turns every polygon's body-frame vertices by its current angle.
 /// Also keeps the inradius of every shape (shapes are only ever added).
 inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
@@ -107,20 +119,9 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
         if (!(hist == V2::zero())) hist = V2::zero();
         return false;
     }
-    BodyState bi, bj;
+    BodyState bi = bodyOf(p, sv, sw, i);
     bi.x = d;
-    bi.v = p.v[i];
-    bi.w = p.w[i][0];
-    bi.vStep = sv[i];
-    bi.wStep = sw[i][0];
-    bi.invMass = p.invMass[i];
-    bi.invInertia = p.invInertia[i];
-    bj.v = p.v[j];
-    bj.w = p.w[j][0];
-    bj.vStep = sv[j];
-    bj.wStep = sw[j][0];
-    bj.invMass = p.invMass[j];
-    bj.invInertia = p.invInertia[j];
+    const BodyState bj = bodyOf(p, sv, sw, j);
     const PolygonCoeffs& c = cs.polygonPair(p.material[i], p.material[j]);
     const double rmin = std::min(ri, rj);
     const PairLengths len = pairLengths(ri, rj);
@@ -272,13 +273,8 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
                         if (!(hist == V2::zero())) hist = V2::zero();
                         continue;
                     }
-                    BodyState bi, bw;
-                    bi.v = p.v[i];
-                    bi.w = p.w[i][0];
-                    bi.vStep = sv[i];
-                    bi.wStep = sw[i][0];
-                    bi.invMass = p.invMass[i];
-                    bi.invInertia = p.invInertia[i];
+                    const BodyState bi = bodyOf(p, sv, sw, i);
+                    BodyState bw;
                     bw.v = wall.velocity;
                     bw.vStep = wall.velocity;
                     const PolygonCoeffs& c = cs.polygonPair(p.material[i], wall.material);
