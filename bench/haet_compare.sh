@@ -13,20 +13,13 @@
 # CPU times, not wall times, are compared: the machines are shared. OUT_DIR defaults to runs/bench.
 set -euo pipefail
 
-[ $# -ge 1 ] || { echo "usage: $0 BUILD_DIR [OUT_DIR]" >&2; exit 2; }
-build=$(cd "$1" && pwd)
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-root=$(cd "$here/.." && pwd)
-out=${2:-$root/runs/bench}
-mkdir -p "$out"
-haet="$build/haet"
+# shellcheck source=bench/lib.sh
+. "$here/lib.sh"
+setup "$0" "$@"
 demo=${DEMO:-$root/examples/haet_demo.toml}
 N=${SWEEP_N:-4000}
 FRACTIONS=${FRACTIONS:-"0.5 0.75 0.9 0.95"}
-[ -x /usr/bin/time ] || { echo "$0: needs /usr/bin/time (Debian package time)" >&2; exit 1; }
-
-# shellcheck source=bench/lib.sh
-. "$here/lib.sh"
 
 # mean of column COL of a series.csv
 mean_col() { awk -F, -v name="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == name) c = i; next }
