@@ -4,6 +4,7 @@
 #include "polygon/geometry.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -443,137 +444,141 @@ bool frozenCell(std::string_view text, const Fail& fail) {
     return false;
 }
 
-}  // namespace
+/// One record of a column file (readColumnFile): its fields, line, and the column of each name (-1: absent).
+template <std::size_t N>
+struct ColumnRecord {
+    const std::vector<std::string_view>& cells;
+    int line;
+    const std::array<int, N>& col;
+    const char* const (&names)[N];
+    const std::function<void(const std::string&)>& fail;
 
-ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
-                             const std::vector<MaterialDef>& materials, const std::string& key) {
+    bool has(std::size_t c) const { return col[c] >= 0; }
+    std::string_view cell(std::size_t c) const { return cells[std::size_t(col[c])]; }
+    double number(std::size_t c) const {
+        const auto v = parseDouble(cell(c));
+        if (!v) fail(std::string("column ") + names[c] + ": expected a number, got " + inQuotes(cell(c)));
+        return *v;
+    }
+};
+
+/// A CSV file of named columns: blank lines and lines starting with '#' are skipped, the first other line is the
+/// header (names from `names`, `known` listing them for the message), each later line a record with as many
+/// fields. header(col, fail) checks the columns present, record(r) reads one record. `what` names a record
+/// ("particle", "polygon") in the messages for a file without header or records.
+template <std::size_t N, class Header, class Record>
+void readColumnFile(const std::filesystem::path& file, const std::string& key, const char* const (&names)[N],
+                    const char* known, const char* what, Header&& header, Record&& record) {
     const std::string name = file.string();
     const std::vector<std::string> lines = readLines(file, key);
-    enum Column { X, Y, Z, Radius, Vx, Vy, Vz, Material, Frozen, kColumns };
-    const char* const columnName[kColumns] = {"x", "y", "z", "radius", "vx", "vy", "vz", "material", "frozen"};
-    std::array<int, kColumns> col;
+    std::array<int, N> col;
     col.fill(-1);
-    std::size_t fields = 0;
+    std::size_t fields = 0, records = 0;
     bool haveHeader = false;
-    ParticleFile out;
-
     for (std::size_t li = 0; li < lines.size(); ++li) {
         const int lineNo = int(li + 1);
         const std::string_view line = trim(lines[li]);
         if (line.empty() || line[0] == '#') continue;
-        auto fail = [&](const std::string& what) { throw ScenarioError({name, lineNo}, key, what); };
+        const std::function<void(const std::string&)> fail = [&](const std::string& why) {
+            throw ScenarioError({name, lineNo}, key, why);
+        };
         const std::vector<std::string_view> cells = splitOn(line, ',');
-
         if (!haveHeader) {
             haveHeader = true;
             fields = cells.size();
-            col = headerColumns(cells, columnName, "the header names columns x, y, z, radius, vx, vy, vz, material, frozen",
-                                fail);
-            if (dimension == 2)
-                for (int j : {int(Z), int(Vz)})
-                    if (col[std::size_t(j)] >= 0)
-                        fail(std::string("column ") + inQuotes(columnName[j]) + " is not used in a 2D scenario");
-            for (int j : {int(X), int(Y), int(Z), int(Radius)}) {
-                if (j == Z && dimension == 2) continue;
-                if (col[std::size_t(j)] < 0) fail(std::string("missing column ") + inQuotes(columnName[j]));
-            }
-            const bool anyV = col[Vx] >= 0 || col[Vy] >= 0 || col[Vz] >= 0;
-            const bool allV = col[Vx] >= 0 && col[Vy] >= 0 && (dimension == 2 || col[Vz] >= 0);
-            if (anyV && !allV)
-                fail(dimension == 3 ? "velocity columns vx, vy, vz go together"
-                                    : "velocity columns vx, vy go together");
+            col = headerColumns(cells, names, known, fail);
+            header(col, fail);
             continue;
         }
-
         if (cells.size() != fields)
             fail("expected " + std::to_string(fields) + " fields, got " + std::to_string(cells.size()));
-        FileParticle p;
-        p.line = lineNo;
-        auto number = [&](Column c) {
-            const std::string_view text = cells[std::size_t(col[c])];
-            const auto v = parseDouble(text);
-            if (!v) fail(std::string("column ") + columnName[c] + ": expected a number, got " + inQuotes(text));
-            return *v;
-        };
-        p.x[0] = number(X);
-        p.x[1] = number(Y);
-        if (dimension == 3) p.x[2] = number(Z);
-        p.radius = number(Radius);
-        if (!(p.radius > 0)) fail("column radius: must be > 0");
-        if (col[Vx] >= 0) {
-            p.v[0] = number(Vx);
-            p.v[1] = number(Vy);
-            if (dimension == 3) p.v[2] = number(Vz);
-        }
-        if (col[Material] >= 0) p.material = materialCell(cells[std::size_t(col[Material])], materials, fail);
-        if (col[Frozen] >= 0) p.frozen = frozenCell(cells[std::size_t(col[Frozen])], fail);
-        out.particles.push_back(p);
+        record(ColumnRecord<N>{cells, lineNo, col, names, fail});
+        ++records;
     }
-    if (!haveHeader) throw ScenarioError({name, 0}, key, "empty particle file: no header line");
-    if (out.particles.empty()) throw ScenarioError({name, int(lines.size())}, key, "the file holds no particles");
+    if (!haveHeader) throw ScenarioError({name, 0}, key, std::string("empty ") + what + " file: no header line");
+    if (records == 0)
+        throw ScenarioError({name, int(lines.size())}, key, std::string("the file holds no ") + what + "s");
+}
+
+}  // namespace
+
+ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
+                             const std::vector<MaterialDef>& materials, const std::string& key) {
+    enum Column { X, Y, Z, Radius, Vx, Vy, Vz, Material, Frozen, kColumns };
+    static const char* const columnName[kColumns] = {"x", "y", "z", "radius", "vx", "vy", "vz", "material", "frozen"};
+    ParticleFile out;
+    auto header = [&](const std::array<int, kColumns>& col, const auto& fail) {
+        if (dimension == 2)
+            for (int j : {int(Z), int(Vz)})
+                if (col[std::size_t(j)] >= 0)
+                    fail(std::string("column ") + inQuotes(columnName[j]) + " is not used in a 2D scenario");
+        for (int j : {int(X), int(Y), int(Z), int(Radius)}) {
+            if (j == Z && dimension == 2) continue;
+            if (col[std::size_t(j)] < 0) fail(std::string("missing column ") + inQuotes(columnName[j]));
+        }
+        const bool anyV = col[Vx] >= 0 || col[Vy] >= 0 || col[Vz] >= 0;
+        const bool allV = col[Vx] >= 0 && col[Vy] >= 0 && (dimension == 2 || col[Vz] >= 0);
+        if (anyV && !allV)
+            fail(dimension == 3 ? "velocity columns vx, vy, vz go together" : "velocity columns vx, vy go together");
+    };
+    auto record = [&](const ColumnRecord<kColumns>& r) {
+        FileParticle p;
+        p.line = r.line;
+        p.x[0] = r.number(X);
+        p.x[1] = r.number(Y);
+        if (dimension == 3) p.x[2] = r.number(Z);
+        p.radius = r.number(Radius);
+        if (!(p.radius > 0)) r.fail("column radius: must be > 0");
+        if (r.has(Vx)) {
+            p.v[0] = r.number(Vx);
+            p.v[1] = r.number(Vy);
+            if (dimension == 3) p.v[2] = r.number(Vz);
+        }
+        if (r.has(Material)) p.material = materialCell(r.cell(Material), materials, r.fail);
+        if (r.has(Frozen)) p.frozen = frozenCell(r.cell(Frozen), r.fail);
+        out.particles.push_back(p);
+    };
+    readColumnFile(file, key, columnName, "the header names columns x, y, z, radius, vx, vy, vz, material, frozen",
+                   "particle", header, record);
     return out;
 }
 
 std::vector<FilePolygon> readPolygonCsv(const std::filesystem::path& file, const std::vector<MaterialDef>& materials,
                                         const std::string& key) {
-    const std::string name = file.string();
-    const std::vector<std::string> lines = readLines(file, key);
     enum Column { Vertices, Vx, Vy, W, Material, Frozen, kColumns };
-    const char* const columnName[kColumns] = {"vertices", "vx", "vy", "w", "material", "frozen"};
-    std::array<int, kColumns> col;
-    col.fill(-1);
-    std::size_t fields = 0;
-    bool haveHeader = false;
+    static const char* const columnName[kColumns] = {"vertices", "vx", "vy", "w", "material", "frozen"};
     std::vector<FilePolygon> out;
-    for (std::size_t li = 0; li < lines.size(); ++li) {
-        const int lineNo = int(li + 1);
-        const std::string_view line = trim(lines[li]);
-        if (line.empty() || line[0] == '#') continue;
-        auto fail = [&](const std::string& what) { throw ScenarioError({name, lineNo}, key, what); };
-        const std::vector<std::string_view> cells = splitOn(line, ',');
-        if (!haveHeader) {
-            haveHeader = true;
-            fields = cells.size();
-            col = headerColumns(cells, columnName, "a polygon file names columns vertices, vx, vy, w, material, frozen",
-                                fail);
-            if (col[Vertices] < 0) fail("missing column \"vertices\"");
-            if ((col[Vx] >= 0) != (col[Vy] >= 0)) fail("velocity columns vx, vy go together");
-            continue;
-        }
-        if (cells.size() != fields)
-            fail("expected " + std::to_string(fields) + " fields, got " + std::to_string(cells.size()));
+    auto header = [&](const std::array<int, kColumns>& col, const auto& fail) {
+        if (col[Vertices] < 0) fail("missing column \"vertices\"");
+        if ((col[Vx] >= 0) != (col[Vy] >= 0)) fail("velocity columns vx, vy go together");
+    };
+    auto record = [&](const ColumnRecord<kColumns>& r) {
         FilePolygon p;
-        p.line = lineNo;
-        auto number = [&](Column c) {
-            const std::string_view text = cells[std::size_t(col[c])];
-            const auto v = parseDouble(text);
-            if (!v) fail(std::string("column ") + columnName[c] + ": expected a number, got " + inQuotes(text));
-            return *v;
-        };
-        const std::vector<std::string_view> coords = whitespaceTokens(cells[std::size_t(col[Vertices])]);
+        p.line = r.line;
+        const std::vector<std::string_view> coords = whitespaceTokens(r.cell(Vertices));
         if (coords.size() % 2 != 0 || coords.size() < 6 || coords.size() > 2 * polygon::kMaxVertices)
-            fail("column vertices: expected 3 to " + std::to_string(polygon::kMaxVertices) +
-                 " vertices as \"x0 y0 x1 y1 ...\", got " + std::to_string(coords.size()) + " numbers");
+            r.fail("column vertices: expected 3 to " + std::to_string(polygon::kMaxVertices) +
+                   " vertices as \"x0 y0 x1 y1 ...\", got " + std::to_string(coords.size()) + " numbers");
         for (std::size_t c = 0; c < coords.size(); c += 2) {
             const auto x = parseDouble(coords[c]), y = parseDouble(coords[c + 1]);
-            if (!x || !y) fail("column vertices: expected numbers, got " + inQuotes(!x ? coords[c] : coords[c + 1]));
+            if (!x || !y) r.fail("column vertices: expected numbers, got " + inQuotes(!x ? coords[c] : coords[c + 1]));
             p.vertices.push_back(Vec<2>{{*x, *y}});
         }
         if (polygon::polygonMoments(p.vertices.data(), int(p.vertices.size())).area < 0)
             std::reverse(p.vertices.begin(), p.vertices.end());
         if (!polygon::isConvexCcw(p.vertices.data(), int(p.vertices.size())))
-            fail("column vertices: the polygon is not convex (or has repeated or collinear vertices)");
-        if (col[Vx] >= 0) {
-            p.v[0] = number(Vx);
-            p.v[1] = number(Vy);
+            r.fail("column vertices: the polygon is not convex (or has repeated or collinear vertices)");
+        if (r.has(Vx)) {
+            p.v[0] = r.number(Vx);
+            p.v[1] = r.number(Vy);
         }
-        if (col[W] >= 0) p.w = number(W);
-        if (col[Material] >= 0) p.material = materialCell(cells[std::size_t(col[Material])], materials, fail);
-        if (col[Frozen] >= 0) p.frozen = frozenCell(cells[std::size_t(col[Frozen])], fail);
+        if (r.has(W)) p.w = r.number(W);
+        if (r.has(Material)) p.material = materialCell(r.cell(Material), materials, r.fail);
+        if (r.has(Frozen)) p.frozen = frozenCell(r.cell(Frozen), r.fail);
         out.push_back(std::move(p));
-    }
-    if (!haveHeader) throw ScenarioError({name, 0}, key, "empty polygon file: no header line");
-    if (out.empty()) throw ScenarioError({name, int(lines.size())}, key, "the file holds no polygons");
+    };
+    readColumnFile(file, key, columnName, "a polygon file names columns vertices, vx, vy, w, material, frozen",
+                   "polygon", header, record);
     return out;
 }
 
