@@ -16,6 +16,7 @@
 #include "scenario/insert.hpp"
 #include "scenario/loader.hpp"
 #include "world/build.hpp"
+#include "scenario_text.hpp"
 
 namespace fs = std::filesystem;
 
@@ -72,18 +73,8 @@ region = { lo = [0, 0.02], hi = [0.05, 0.05] }
 snapshot_period = 0.001
 )";
 
-int lineOf(const std::string& text, const std::string& needle) {
-    const auto at = text.find(needle);
-    EXPECT_NE(at, std::string::npos) << needle;
-    return 1 + int(std::count(text.begin(), text.begin() + std::ptrdiff_t(at), '\n'));
-}
-
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    return text;
-}
+using haet::testing::lineOf;
+using haet::testing::replaced;
 
 class PolygonScenario : public ::testing::Test {
 protected:

@@ -12,6 +12,7 @@
 #include "core/rng.hpp"
 #include "scenario/insert.hpp"
 #include "scenario/loader.hpp"
+#include "scenario_text.hpp"
 
 namespace fs = std::filesystem;
 using namespace haet;
@@ -136,20 +137,8 @@ frozen = true
 snapshot_period = -1
 )";
 
-/// 1-based line of the first occurrence of `needle` in `text`.
-int lineOf(const std::string& text, const std::string& needle) {
-    const auto at = text.find(needle);
-    EXPECT_NE(at, std::string::npos) << needle;
-    return 1 + int(std::count(text.begin(), text.begin() + std::ptrdiff_t(at), '\n'));
-}
-
-/// `text` with the first occurrence of `from` replaced by `to`.
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    return text;
-}
+using haet::testing::lineOf;
+using haet::testing::replaced;
 
 class ScenarioTest : public ::testing::Test {
 protected:
