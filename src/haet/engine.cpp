@@ -534,22 +534,21 @@ void HaetEngine<D>::convert(std::vector<std::uint32_t> arrivals, std::vector<std
         --nT;
     }
     p.nTdm = nT;
-    for (std::size_t k = 0; k < departures.size(); ++k) {
-        edm_->add(nT + k, t);
-        watch_.push_back(static_cast<std::uint32_t>(nT + k));
-    }
     counters_.toTdm += arrivals.size();
     counters_.toEdm += departures.size();
-    // Watched indices follow their particles.
+    // Watched indices follow their particles (before the departed ones join the list with their new indices).
     if (!origin.empty() && !watch_.empty()) {
         std::unordered_map<std::uint32_t, std::uint32_t> now;  // original index -> current index
         for (const auto& [cur, orig] : origin) now[orig] = cur;
         for (std::uint32_t& i : watch_) {
-            if (i >= nT && i < nT + departures.size()) continue;  // just added
             auto f = now.find(i);
             if (f != now.end()) i = f->second;
         }
         watchSorted_ = 0;  // renumbered: sorted anew at the next check
+    }
+    for (std::size_t k = 0; k < departures.size(); ++k) {
+        edm_->add(nT + k, t);
+        watch_.push_back(static_cast<std::uint32_t>(nT + k));
     }
     tdm_->remap(from);
     ++binsEpoch_;
@@ -569,6 +568,18 @@ void HaetEngine<D>::convert(std::vector<std::uint32_t> arrivals, std::vector<std
 template <int D>
 void HaetEngine<D>::forceModes(const std::vector<std::uint32_t>& toTdm, const std::vector<std::uint32_t>& toEdm) {
     convert(toTdm, toEdm);
+}
+
+template <int D>
+std::size_t HaetEngine<D>::unwatchedInGuard() const {
+    std::vector<std::uint32_t> watched = watch_;
+    std::sort(watched.begin(), watched.end());
+    std::size_t missing = 0;
+    for (std::size_t i = nTdm(); i < w_.particles.size(); ++i)
+        if (guard_[edm_->cellOfParticle(i)] != 0 &&
+            !std::binary_search(watched.begin(), watched.end(), static_cast<std::uint32_t>(i)))
+            ++missing;
+    return missing;
 }
 
 // ---------------------------------------------------------------------------------------------------------------

@@ -84,6 +84,9 @@ public:
     void forceModes(const std::vector<std::uint32_t>& toTdm, const std::vector<std::uint32_t>& toEdm);
     /// Switches the automatic mode changes off (tests of a fixed split) or on.
     void freezeModes(bool on) { frozenModes_ = on; }
+    /// The guard's invariant (tests): event-driven particles in guard cells that are not watched. Zero always,
+    /// or such a particle could touch a TDM particle unnoticed. O(N log N).
+    std::size_t unwatchedInGuard() const;
 
 private:
     struct Binned {  // a TDM particle as seen by the guard: position at the last relabel, radius, next in cell
