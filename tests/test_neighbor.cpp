@@ -100,10 +100,11 @@ TEST(Neighbor, HistorySurvivesRebuildAndPermutation) {
 }
 
 /// The incremental update of a hybrid mode change against a full build: particles leave (the last TDM particle
-/// takes a leaver's place) and new ones join at the end; the pairs must be those of a fresh build, and the history
-/// of kept pairs must follow its particles.
+/// takes a leaver's place) and new ones join at the end; the pairs must be those of a fresh build, each row sorted
+/// by partner, and the history of kept pairs must follow its particles. Without leavers the kept particles keep
+/// their numbers (the update's fast path).
 template <int D>
-void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed, std::size_t joining) {
+void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed, std::size_t joining, bool leave = true) {
     Domain<D> dom;
     dom.lo = Vec<D>::zero();
     dom.hi = Vec<D>::filled(1.0);
@@ -121,7 +122,7 @@ void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed, std::size_t 
     std::vector<std::uint32_t> from(n0);
     for (std::size_t k = 0; k < n0; ++k) from[k] = static_cast<std::uint32_t>(k);
     std::size_t nT = n0;
-    for (std::size_t d = 17 * 59; ; d -= 17) {
+    for (std::size_t d = 17 * 59; leave; d -= 17) {
         all.swapEntries(d, nT - 1);
         from[d] = from[nT - 1];
         from.pop_back();
@@ -139,6 +140,8 @@ void remapMatchesBuild(std::array<bool, D> periodic, unsigned seed, std::size_t 
     PairList<D> ref;
     buildPairList(all, dom, s, PairList<D>{}, ref);
     EXPECT_EQ(pairSet(list), pairSet(ref));
+    for (std::size_t i = 0; i < nT; ++i)
+        EXPECT_TRUE(std::is_sorted(list.partner.begin() + list.first[i], list.partner.begin() + list.first[i + 1]));
     buildTransposedIndex(list);
     EXPECT_EQ(list.pairT.size(), list.size());
     std::size_t kept = 0;
@@ -158,12 +161,16 @@ TEST(Neighbor, RemapAfterModeChangeMatchesBuild3D) {
     remapMatchesBuild<3>({true, true, true}, 21, 100);
     remapMatchesBuild<3>({false, true, false}, 22, 100);
     remapMatchesBuild<3>({true, true, true}, 25, 5);
+    remapMatchesBuild<3>({true, false, true}, 27, 100, false);
+    remapMatchesBuild<3>({false, false, false}, 28, 4, false);
 }
 
 TEST(Neighbor, RemapAfterModeChangeMatchesBuild2D) {
     remapMatchesBuild<2>({true, true}, 23, 100);
     remapMatchesBuild<2>({false, false}, 24, 100);
     remapMatchesBuild<2>({false, true}, 26, 3);
+    remapMatchesBuild<2>({true, true}, 29, 100, false);
+    remapMatchesBuild<2>({false, false}, 30, 2, false);
 }
 
 /// A kept particle that drifted away from a newcomer since the last build may drift back by skin/2 before the next

@@ -467,32 +467,40 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
     std::vector<std::uint32_t> inv(nOld, kNone);
     std::vector<std::uint8_t> fresh(n, 0);
     std::vector<std::uint32_t> freshList;
+    // Only particles added after the kept ones, which keep their numbers (a hybrid step with arrivals only): the
+    // kept rows stay as they are and the new pairs go to their ends.
+    bool appended = true;
     for (std::size_t k = 0; k < n; ++k) {
-        if (from[k] < nOld)
+        if (from[k] < nOld) {
             inv[from[k]] = static_cast<std::uint32_t>(k);
-        else {
+            appended = appended && from[k] == k;
+        } else {
             fresh[k] = 1;
             freshList.push_back(static_cast<std::uint32_t>(k));
         }
     }
+    appended = appended && (freshList.empty() || freshList.front() == n - freshList.size()) &&
+               n - freshList.size() == nOld;
     struct Entry {
         std::uint32_t a, b;
         std::uint8_t code;
         Vec<D> h;
     };
     std::vector<Entry> entries;
-    entries.reserve(list.partner.size() + 8 * freshList.size());
-    for (std::size_t i = 0; i < nOld; ++i) {
-        const std::uint32_t a = inv[i];
-        if (a == kNone) continue;
-        for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
-            const std::uint32_t b = inv[list.partner[k]];
-            if (b == kNone) continue;
-            const Vec<D> h = list.history.empty() ? Vec<D>::zero() : list.history[k];
-            if (a < b)
-                entries.push_back({a, b, list.shift[k], h});
-            else
-                entries.push_back({b, a, static_cast<std::uint8_t>(kMirror - list.shift[k]), -h});
+    if (!appended) {
+        entries.reserve(list.partner.size() + 8 * freshList.size());
+        for (std::size_t i = 0; i < nOld; ++i) {
+            const std::uint32_t a = inv[i];
+            if (a == kNone) continue;
+            for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k) {
+                const std::uint32_t b = inv[list.partner[k]];
+                if (b == kNone) continue;
+                const Vec<D> h = list.history.empty() ? Vec<D>::zero() : list.history[k];
+                if (a < b)
+                    entries.push_back({a, b, list.shift[k], h});
+                else
+                    entries.push_back({b, a, static_cast<std::uint8_t>(kMirror - list.shift[k]), -h});
+            }
         }
     }
     // A kept particle j may have drifted by d_j from where its pairs were last searched, and may drift back the
@@ -501,9 +509,19 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
     auto drift = [&](std::uint32_t j) { return ref && !fresh[j] ? norm(p.x[j] - ref[j]) : 0.0; };
     // A few new particles are tested against all (a grid costs O(cells), and a tall box has many); many use a grid.
     if (!freshList.empty() && freshList.size() * 64 <= n) {
+        // On open axes a partner farther than the largest reach along the axis is skipped before the full test.
+        double rmax = 0, dmax = 0;
+        for (std::uint32_t i = 0; i < n; ++i) {
+            rmax = std::max(rmax, p.radius[i]);
+            if (ref) dmax = std::max(dmax, drift(i));
+        }
+        const double reach = 2 * rmax + s.skin + dmax;
         for (const std::uint32_t f : freshList)
             for (std::uint32_t j = 0; j < n; ++j) {
                 if (j == f || (fresh[j] && j < f)) continue;
+                bool far = false;
+                for (int k = 0; k < D; ++k) far = far || (!dom.periodic[k] && std::abs(p.x[f][k] - p.x[j][k]) >= reach);
+                if (far) continue;
                 const std::uint32_t lo = std::min(f, j), hi = std::max(f, j);
                 std::uint8_t code;
                 if (testPair(p, dom, s, lo, hi, code, drift(j))) entries.push_back({lo, hi, code, Vec<D>::zero()});
@@ -532,6 +550,39 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 }
         }
     }
+    list.shiftVec = makeShiftVectors(dom);
+    list.firstT.clear();  // the transposed index and the thread split are built by the force loop when needed
+    list.pairT.clear();
+    list.split = ThreadSplit{};
+    if (appended) {
+        // Every new pair has a new particle as its second: it comes after the kept partners of its row.
+        std::sort(entries.begin(), entries.end(),
+                  [](const Entry& x, const Entry& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+        const std::size_t np = list.partner.size() + entries.size();
+        std::vector<std::uint32_t> first(n + 1), partner(np);
+        std::vector<std::uint8_t> shift(np);
+        std::vector<Vec<D>> history(np, Vec<D>::zero());
+        std::size_t o = 0, e = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            first[i] = static_cast<std::uint32_t>(o);
+            if (i < nOld)
+                for (std::uint32_t k = list.first[i]; k < list.first[i + 1]; ++k, ++o) {
+                    partner[o] = list.partner[k];
+                    shift[o] = list.shift[k];
+                    if (!list.history.empty()) history[o] = list.history[k];
+                }
+            for (; e < entries.size() && entries[e].a == i; ++e, ++o) {
+                partner[o] = entries[e].b;
+                shift[o] = entries[e].code;
+            }
+        }
+        first[n] = static_cast<std::uint32_t>(o);
+        list.first.swap(first);
+        list.partner.swap(partner);
+        list.shift.swap(shift);
+        list.history.swap(history);
+        return;
+    }
     // Counting sort by the first index, then each (short) row by the partner.
     list.first.assign(n + 1, 0);
     for (const Entry& e : entries) ++list.first[e.a + 1];
@@ -554,10 +605,6 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 std::swap(list.shift[q - 1], list.shift[q]);
                 std::swap(list.history[q - 1], list.history[q]);
             }
-    list.shiftVec = makeShiftVectors(dom);
-    list.firstT.clear();  // the transposed index and the thread split are built by the force loop when needed
-    list.pairT.clear();
-    list.split = ThreadSplit{};
 }
 
 template <int D>
