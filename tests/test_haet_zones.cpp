@@ -97,5 +97,64 @@ TEST(HaetZones, PeriodicBufferWraps3D) {
     EXPECT_FALSE(g.timeDriven(g.zoneOf(Vec<3>{{2.5, 2.5, 0.5}})));  // beyond the buffer
 }
 
+/// The axis-by-axis smoothing and buffer against their definition zone by zone (every zone within the radius on
+/// each axis, each once), on grids of 1 to 5 zones per axis, periodic and open, buffers 0 to 2.
+template <int D>
+void smoothingAndBufferMatchDefinition(std::uint32_t seed) {
+    std::uint32_t state = seed;
+    auto next = [&] {
+        state = state * 1664525u + 1013904223u;
+        return state >> 8;
+    };
+    for (int trial = 0; trial < 40; ++trial) {
+        Domain<D> d;
+        d.lo = Vec<D>::zero();
+        std::array<int, D> n;
+        for (int k = 0; k < D; ++k) {
+            n[k] = 1 + static_cast<int>(next() % 5);
+            d.hi[k] = n[k];
+            d.periodic[k] = next() % 2 == 0;
+        }
+        const int buffer = static_cast<int>(next() % 3);
+        ZoneGrid<D> g(d, {1.0, 0.3, 0.25, buffer});
+        std::vector<double> vol(static_cast<std::size_t>(g.count()));
+        for (double& v : vol) v = next() % 3 == 0 ? 0.0 : (next() % 1000) / 1000.0;
+        g.relabel(vol, {});
+        auto coords = [&](int z) {
+            std::array<int, D> c;
+            for (int k = 0; k < D; ++k) c[k] = (z / g.stride(k)) % n[k];
+            return c;
+        };
+        // zones within `radius` of z on every axis, each once
+        auto around = [&](int z, int radius) {
+            std::vector<int> out;
+            const std::array<int, D> c = coords(z);
+            for (int q = 0; q < g.count(); ++q) {
+                const std::array<int, D> e = coords(q);
+                bool in = true;
+                for (int k = 0; k < D; ++k) {
+                    int dist = std::abs(e[k] - c[k]);
+                    if (d.periodic[k]) dist = std::min(dist, n[k] - dist);
+                    in = in && dist <= radius;
+                }
+                if (in) out.push_back(q);
+            }
+            return out;
+        };
+        for (int z = 0; z < g.count(); ++z) {
+            double sum = 0;
+            const std::vector<int> nb = around(z, 1);
+            for (const int q : nb) sum += vol[q];
+            EXPECT_NEAR(g.smoothed(z), sum / static_cast<double>(nb.size()), 1e-14) << "trial " << trial;
+            bool any = false;
+            for (const int q : around(z, buffer)) any = any || g.dense(q);
+            EXPECT_EQ(g.timeDriven(z), any) << "trial " << trial << " zone " << z;
+        }
+    }
+}
+
+TEST(HaetZones, SmoothingAndBufferMatchTheirDefinition2D) { smoothingAndBufferMatchDefinition<2>(7); }
+TEST(HaetZones, SmoothingAndBufferMatchTheirDefinition3D) { smoothingAndBufferMatchDefinition<3>(8); }
+
 }  // namespace
 }  // namespace haet

@@ -20,21 +20,14 @@ ZoneGrid<D>::ZoneGrid(const Domain<D>& dom, const ZoneSettings& s) : s_(s) {
     phiSmooth_.assign(total_, 0.0);
     dense_.assign(total_, 0);
     tdm_.assign(total_, 0);
-    buildNeighbours();
-}
-
-template <int D>
-void ZoneGrid<D>::buildNeighbours() {
-    auto build = [&](int radius, std::vector<int>& first, std::vector<int>& list) {
-        first.assign(total_ + 1, 0);
-        list.clear();
-        for (int z = 0; z < total_; ++z) {
-            forNeighbours(z, radius, [&](int q) { list.push_back(q); });
-            first[z + 1] = static_cast<int>(list.size());
-        }
-    };
-    build(1, nb1First_, nb1_);
-    build(s_.buffer, nbBFirst_, nbB_);
+    // 1 / the number of zones each zone's smoothing averages (the 3^D block, clipped at open faces).
+    std::vector<double> one(total_, 1.0), count = one;
+    for (int k = 0; k < D; ++k) {
+        alongAxis(k, 1, count, one, [](double a, double b) { return a + b; });
+        count.swap(one);
+    }
+    invCount_.resize(total_);
+    for (int z = 0; z < total_; ++z) invCount_[z] = 1.0 / count[z];
 }
 
 template <int D>
@@ -50,37 +43,41 @@ int ZoneGrid<D>::zoneOf(const Vec<D>& x) const {
 }
 
 template <int D>
-template <class F>
-void ZoneGrid<D>::forNeighbours(int z, int radius, F&& f) const {
-    std::array<int, D> c;
-    int t = z;
-    for (int k = 0; k < D; ++k) {
-        c[k] = t % n_[k];
-        t /= n_[k];
-    }
-    const int side = 2 * radius + 1;
-    int m = 1;
-    for (int k = 0; k < D; ++k) m *= side;
-    // At most (2r+1)^D zones; small for the radii used (1 for smoothing, `buffer` for the buffer).
-    std::vector<int> seen;
-    seen.reserve(m);
-    for (int code = 0; code < m; ++code) {
-        int q = code, idx = 0, mul = 1;
-        bool ok = true;
-        for (int k = 0; k < D; ++k) {
-            int ck = c[k] + q % side - radius;
-            q /= side;
-            if (ck < 0 || ck >= n_[k]) {
-                if (!periodic_[k]) { ok = false; break; }
-                ck = ((ck % n_[k]) + n_[k]) % n_[k];
+template <class T, class Op>
+void ZoneGrid<D>::alongAxis(int k, int radius, const std::vector<T>& in, std::vector<T>& out, Op op) const {
+    const int n = n_[k], stride = this->stride(k), lines = total_ / (stride * n);
+    // Offsets -radius..radius reach each zone of a periodic axis once at most: at most n of them.
+    const int lo = periodic_[k] ? -std::min(radius, (n - 1) / 2) : -radius;
+    const int hi = periodic_[k] ? std::min(radius, n / 2) : radius;
+    for (int line = 0; line < lines; ++line)
+        for (int inner = 0; inner < stride; ++inner) {
+            const T* a = in.data() + line * stride * n + inner;
+            T* b = out.data() + line * stride * n + inner;
+            // Zones whose window stays inside the axis, then the ones at its ends (clipped or wrapped).
+            const int c0 = std::min(n, -lo), c1 = std::max(c0, n - hi);
+            for (int c = c0; c < c1; ++c) {
+                const T* w = a + (c + lo) * stride;
+                T acc = w[0];
+                for (int o = 1; o <= hi - lo; ++o) acc = op(acc, w[o * stride]);
+                b[c * stride] = acc;
             }
-            idx += ck * mul;
-            mul *= n_[k];
+            auto edge = [&](int c) {
+                T acc{};
+                bool first = true;
+                for (int o = lo; o <= hi; ++o) {
+                    int q = c + o;
+                    if (q < 0 || q >= n) {
+                        if (!periodic_[k]) continue;
+                        q = q < 0 ? q + n : q - n;
+                    }
+                    acc = first ? a[q * stride] : op(acc, a[q * stride]);
+                    first = false;
+                }
+                b[c * stride] = acc;
+            };
+            for (int c = 0; c < c0; ++c) edge(c);
+            for (int c = c1; c < n; ++c) edge(c);
         }
-        if (!ok || std::find(seen.begin(), seen.end(), idx) != seen.end()) continue;
-        seen.push_back(idx);
-        f(idx);
-    }
 }
 
 template <int D>
@@ -93,12 +90,14 @@ void ZoneGrid<D>::relabel(const Particles<D>& p, const std::vector<std::uint8_t>
 template <int D>
 void ZoneGrid<D>::relabel(const std::vector<double>& volume, const std::vector<std::uint8_t>& sticky) {
     for (int z = 0; z < total_; ++z) phi_[z] = volume[z] / cellVolume_;
-    // Smoothing over the zone and its neighbours damps the noise of a few particles crossing a zone edge.
-    for (int z = 0; z < total_; ++z) {
-        double sum = 0;
-        for (int k = nb1First_[z]; k < nb1First_[z + 1]; ++k) sum += phi_[nb1_[k]];
-        phiSmooth_[z] = sum / (nb1First_[z + 1] - nb1First_[z]);
+    // Smoothing over the zone and its neighbours damps the noise of a few particles crossing a zone edge: the mean
+    // over the 3^D block (clipped at open faces), summed axis by axis.
+    sum_ = phi_;
+    for (int k = 0; k < D; ++k) {
+        alongAxis(k, 1, sum_, phiSmooth_, [](double a, double b) { return a + b; });
+        sum_.swap(phiSmooth_);
     }
+    for (int z = 0; z < total_; ++z) phiSmooth_[z] = sum_[z] * invCount_[z];
     for (int z = 0; z < total_; ++z) {
         const bool stick = z < static_cast<int>(sticky.size()) && sticky[z];
         if (dense_[z])
@@ -106,11 +105,17 @@ void ZoneGrid<D>::relabel(const std::vector<double>& volume, const std::vector<s
         else
             dense_[z] = stick || phiSmooth_[z] > s_.phiOn;
     }
+    // Time-driven: a dense zone within `buffer` on every axis (a dilation, axis by axis).
+    mark_ = dense_;
+    std::vector<std::uint8_t> next(total_);
+    for (int k = 0; k < D && s_.buffer > 0; ++k) {
+        alongAxis(k, s_.buffer, mark_, next, [](std::uint8_t a, std::uint8_t b) -> std::uint8_t { return a | b; });
+        mark_.swap(next);
+    }
     changed_ = 0;
     for (int z = 0; z < total_; ++z) {
-        bool any = false;
-        for (int k = nbBFirst_[z]; k < nbBFirst_[z + 1] && !any; ++k) any = dense_[nbB_[k]];
-        if (any != static_cast<bool>(tdm_[z])) ++changed_;
+        const std::uint8_t any = mark_[z] != 0;
+        if (any != tdm_[z]) ++changed_;
         tdm_[z] = any;
     }
 }

@@ -51,11 +51,10 @@ public:
     Vec<D> origin() const { return lo_; }
 
 private:
-    /// Neighbour zones within `radius` (periodic axes wrap; others are clipped), without duplicates.
-    template <class F>
-    void forNeighbours(int z, int radius, F&& f) const;
-    /// Neighbour lists (CSR) for radius 1 and for the buffer radius, built once.
-    void buildNeighbours();
+    /// out[z] = op over the zones within `radius` of z along axis k (periodic axes wrap, each zone once; open
+    /// axes are clipped): one pass of a box filter that is separable over the axes.
+    template <class T, class Op>
+    void alongAxis(int k, int radius, const std::vector<T>& in, std::vector<T>& out, Op op) const;
 
     ZoneSettings s_;
     std::array<int, D> n_{};
@@ -65,7 +64,9 @@ private:
     double cellVolume_ = 1;
     std::vector<double> phi_, phiSmooth_;
     std::vector<std::uint8_t> dense_, tdm_;
-    std::vector<int> nb1First_, nb1_, nbBFirst_, nbB_;
+    std::vector<double> invCount_;  // 1 / zones in each zone's smoothing block
+    std::vector<double> sum_;       // scratch of relabel
+    std::vector<std::uint8_t> mark_;
     std::size_t changed_ = 0;
 };
 
