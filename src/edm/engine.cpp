@@ -114,8 +114,12 @@ void EdmEngine<D>::reset() {
     // Slots in World order first, then sorted cell by cell.
     buildGrid();
     hot_.resize(n);
-    link_.assign(n, Link{kNil, 0, Shift{}});
-    rec_.assign(n, Rec{Candidate{}, -std::numeric_limits<double>::infinity(), kNone << kTypeShift, 0, kNil, 0});
+    link_.assign(n, Link{kNil, 0, packWraps(Shift{})});
+    rec_.assign(n, Rec{Candidate{}, 0, 0, 0});
+    if (tc_ > 0)
+        tLast_.assign(n, -std::numeric_limits<double>::infinity());
+    else
+        std::vector<double>().swap(tLast_);
     const std::uint32_t freeCell = static_cast<std::uint32_t>(head_.size());
     for (std::uint32_t i = 0; i < n; ++i) {
         const bool fz = p.frozen(i);
@@ -179,8 +183,10 @@ void EdmEngine<D>::buildGrid() {
                                               "plus the neighbour shell"
                                             : "event-driven engine: cellSize is smaller than the largest diameter");
     if (!(edge > 0)) edge = 1;
-    // At most max(2^20, 8 N) cells: a huge open box with few particles gets larger cells.
-    const double maxCells = std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size()));
+    // At most max(2^20, 8 N) cells: a huge open box with few particles gets larger cells. Below 2^29 - 1 in any
+    // case: Rec::cell has 29 bits and the free slots' cell is the one past the last.
+    const double maxCells = std::min(double((1u << kCellBits) - 2),
+                                     std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size())));
     for (;;) {
         double total = 1;
         for (int k = 0; k < D; ++k) {
@@ -232,20 +238,30 @@ std::uint32_t EdmEngine<D>::cellOf(const Vec<D>& x) const {
 template <int D>
 void EdmEngine<D>::insertCell(std::uint32_t s, std::uint32_t c) {
     rec_[s].cell = c;
-    rec_[s].prev = kNil;
     link_[s].next = head_[c];
-    if (head_[c] != kNil) rec_[head_[c]].prev = s;
     head_[c] = s;
 }
 
+// A cell holds about one particle (two at most in most cells), so walking its list costs less than a back link
+// per slot would: no predecessor to keep, 4 bytes per particle fewer.
 template <int D>
 void EdmEngine<D>::removeCell(std::uint32_t s) {
-    const std::uint32_t nx = link_[s].next;
-    if (rec_[s].prev != kNil)
-        link_[rec_[s].prev].next = nx;
-    else
-        head_[rec_[s].cell] = nx;
-    if (nx != kNil) rec_[nx].prev = rec_[s].prev;
+    std::uint32_t* at = &head_[rec_[s].cell];
+    while (*at != s) at = &link_[*at].next;
+    *at = link_[s].next;
+}
+
+template <int D>
+void EdmEngine<D>::setWraps(std::uint32_t s, Shift w) {
+    for (int k = 0; k < D; ++k) {
+        if (std::abs(w[k]) <= kWrapLimit) continue;
+        // Whole box lengths from the stored position into Particles::image, as syncSlot does; the box-frame
+        // position and so the cell and the pending events stay (the stored x is rounded, as at a synchronisation).
+        hot_[s].x[k] -= w[k] * boxLen_[k];
+        w_.particles.image[rec_[s].idx][k] += w[k] * boxLen_[k];
+        w[k] = 0;
+    }
+    link_[s].wrap = packWraps(w);
 }
 
 template <int D>
@@ -278,6 +294,7 @@ void EdmEngine<D>::resort() {
     permute(hot_);
     permute(link_);
     permute(rec_);
+    if (!tLast_.empty()) permute(tLast_);
     if (shells_) {
         permute(centre_);
         if (!nbr_.empty()) {
@@ -297,10 +314,7 @@ void EdmEngine<D>::resort() {
     auto renumber = [&](std::uint32_t& code) {
         if ((code >> kTypeShift) == kPair) code = (kPair << kTypeShift) | newSlot[code & kIndexMask];
     };
-    for (std::size_t k = 0; k < n; ++k) {
-        renumber(rec_[k].evCode);
-        renumber(rec_[k].coll.code);
-    }
+    for (std::size_t k = 0; k < n; ++k) renumber(rec_[k].coll.code);
     queue_.build(times);
     linkCells();
     slotOf_.assign(w_.particles.size(), kNil);
@@ -470,7 +484,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
     }
     const Domain<D>& dom = w_.domain;
     const Hot& hs = hot_[s];
-    const Shift ws = link_[s].wrap;
+    const Shift ws = wrapsOf(link_[s].wrap);
     // Cell coordinates, the faces s can leave through, and the neighbour cells per axis. The exit is computed from
     // the state at "now": from the older stored state the quadratic can also find a crossing that already
     // happened (through a face and back under gravity).
@@ -573,10 +587,11 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
             const std::uint32_t nextJ = lj.next;
             if (j != s) {
                 const Hot& hj = hot_[j];
+                const Shift wj = wrapsOf(lj.wrap);
                 double t = kNever;
                 if (hj.t == kNever) {
                     Shift m;
-                    for (int k = 0; k < D; ++k) m[k] = base[k] + lj.wrap[k];
+                    for (int k = 0; k < D; ++k) m[k] = base[k] + wj[k];
                     t = pairTime(s, j, m, now, best.time);
                 } else {
                     double r[D], v[D], tr;
@@ -585,7 +600,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
                         const double db = ts - hj.t;
                         for (int k = 0; k < D; ++k) {
                             const double xb = hj.x[k] + (hj.v[k] + gHalf[k] * db) * db;
-                            r[k] = (hs.x[k] - xb) + (base[k] + lj.wrap[k]) * boxLen_[k];
+                            r[k] = (hs.x[k] - xb) + (base[k] + wj[k]) * boxLen_[k];
                             v[k] = hs.v[k] - (hj.v[k] + g_[k] * db);
                         }
                     } else {
@@ -593,7 +608,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
                         const double da = hj.t - ts;
                         for (int k = 0; k < D; ++k) {
                             const double xa = hs.x[k] + (hs.v[k] + gHalf[k] * da) * da;
-                            r[k] = (xa - hj.x[k]) + (base[k] + lj.wrap[k]) * boxLen_[k];
+                            r[k] = (xa - hj.x[k]) + (base[k] + wj[k]) * boxLen_[k];
                             v[k] = (hs.v[k] + g_[k] * da) - hj.v[k];
                         }
                     }
@@ -612,7 +627,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
                             t = tr + firstRootFalling(c, 2 * b, 2 * v2);
                             if (t < now) {
                                 Shift m;
-                                for (int k = 0; k < D; ++k) m[k] = base[k] + lj.wrap[k];
+                                for (int k = 0; k < D; ++k) m[k] = base[k] + wj[k];
                                 t = pairTimeFromNow(s, j, m, now);
                             }
                         }
@@ -625,9 +640,8 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
         }
     }
     rec_[s].coll = best;
-    const Candidate& next = cross.better(best.time, best.code) ? best : cross;
-    rec_[s].evCode = next.code;
-    queue_.update(s, next.time);
+    rec_[s].exit = cross.code & 7u;
+    queue_.update(s, cross.better(best.time, best.code) ? best.time : cross.time);
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -717,7 +731,7 @@ template <int D>
 void EdmEngine<D>::moveShell(std::uint32_t s, double now) {
     unlinkShell(s);
     const Vec<D> x = posAt(hot_[s], now);
-    Shift& ws = link_[s].wrap;
+    Shift ws = wrapsOf(link_[s].wrap);
     Vec<D> c;
     for (int k = 0; k < D; ++k) {
         c[k] = x[k] - ws[k] * boxLen_[k];
@@ -726,6 +740,7 @@ void EdmEngine<D>::moveShell(std::uint32_t s, double now) {
         ws[k] += static_cast<std::int32_t>(std::floor((c[k] - lo) / L));
         c[k] = x[k] - ws[k] * boxLen_[k];
     }
+    setWraps(s, ws);
     centre_[s].c = c;
     const std::uint32_t cell = cellOf(c);
     if (cell != rec_[s].cell) {
@@ -777,7 +792,7 @@ void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
         __builtin_prefetch(&hot_[a[q] & kSlotMask]);
         if (periodic_) __builtin_prefetch(&link_[a[q] & kSlotMask]);
     }
-    const Shift ws = link_[s].wrap;
+    const Shift ws = wrapsOf(link_[s].wrap);
     const Vec<D> xNow = posAt(hs, now), vNow = velAt(hs, now);
     const Vec<D>& c = centre_[s].c;
     Candidate cross;
@@ -800,7 +815,7 @@ void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
         Shift m{};
         if (periodic_) {
             const std::uint32_t image = a[q] >> kImageShift;
-            const Shift& wj = link_[j].wrap;
+            const Shift wj = wrapsOf(link_[j].wrap);
             for (int k = 0; k < D; ++k) m[k] = wj[k] - ws[k] - (static_cast<std::int32_t>((image >> (2 * k)) & 3u) - 1);
         }
         const double t = candidateTime(hs, s, j, m, now, best.time);
@@ -812,21 +827,19 @@ void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
     }
     if (bestJ != kNil) best.stamp = link_[bestJ].count;
     rec_[s].coll = best;
-    const Candidate& next = cross.better(best.time, best.code) ? best : cross;
-    rec_[s].evCode = next.code;
-    queue_.update(s, next.time);
+    rec_[s].exit = cross.code & 7u;
+    queue_.update(s, cross.better(best.time, best.code) ? best.time : cross.time);
 }
 
 template <int D>
 void EdmEngine<D>::crossCell(std::uint32_t s, int axis, bool up) {
     const int c = static_cast<int>((rec_[s].cell / stride_[axis]) % static_cast<std::uint32_t>(nCell_[axis]));
     int cn = c + (up ? 1 : -1);
-    if (cn >= nCell_[axis]) {  // only on periodic axes: outer cells of open axes are unbounded
-        cn = 0;
-        link_[s].wrap[axis] += 1;
-    } else if (cn < 0) {
-        cn = nCell_[axis] - 1;
-        link_[s].wrap[axis] -= 1;
+    if (cn >= nCell_[axis] || cn < 0) {  // only on periodic axes: outer cells of open axes are unbounded
+        cn = cn < 0 ? nCell_[axis] - 1 : 0;
+        Shift ws = wrapsOf(link_[s].wrap);
+        ws[axis] += up ? 1 : -1;
+        setWraps(s, ws);
     }
     const std::uint32_t newCell =
         rec_[s].cell + (static_cast<std::uint32_t>(cn) - static_cast<std::uint32_t>(c)) * stride_[axis];
@@ -869,8 +882,8 @@ CollisionLaw EdmEngine<D>::lawFor(int matA, int matB, bool elastic) const {
 template <int D>
 bool EdmEngine<D>::tcElastic(std::uint32_t a, std::uint32_t b, double t) const {
     if (!(tc_ > 0)) return false;
-    if (t - rec_[a].tLast < tc_) return true;
-    return b != kNil && t - rec_[b].tLast < tc_;
+    if (t - tLast_[a] < tc_) return true;
+    return b != kNil && t - tLast_[b] < tc_;
 }
 
 template <int D>
@@ -932,12 +945,12 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     hot_[a].v = b1.v;
     p.w[i] = b1.w;
     ++link_[a].count;
-    rec_[a].tLast = t;
+    if (tc_ > 0) tLast_[a] = t;
     if (!fb) {
         hot_[b].v = b2.v;
         p.w[j] = b2.w;
         ++link_[b].count;
-        rec_[b].tLast = t;
+        if (tc_ > 0) tLast_[b] = t;
     }
     virial_ += dot(d, P);
     ++stats_.pairCollisions;
@@ -973,7 +986,7 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     hot_[s].v = b1.v;
     p.w[i] = b1.w;
     ++link_[s].count;
-    rec_[s].tLast = t;
+    if (tc_ > 0) tLast_[s] = t;
     ++stats_.wallCollisions;
     if (elastic) ++stats_.tcElastic;
     if (hop) ++stats_.restHops;
@@ -1008,7 +1021,8 @@ void EdmEngine<D>::processNext() {
     const std::uint32_t s = queue_.top();
     const double t = queue_.topTime();
     countEvent(t);
-    const std::uint32_t code = rec_[s].evCode;
+    const Rec& rs = rec_[s];
+    const std::uint32_t code = t == rs.coll.time ? rs.coll.code : (kCell << kTypeShift) | rs.exit;
     const std::uint32_t k = code & kIndexMask;
     switch (code >> kTypeShift) {
         case kPair:
@@ -1058,6 +1072,7 @@ void EdmEngine<D>::syncSlot(std::uint32_t s, double t) {
     advance(s, t);
     Hot& h = hot_[s];
     const std::uint32_t i = rec_[s].idx;
+    Shift ws = wrapsOf(link_[s].wrap);
     for (int k = 0; k < D; ++k) {
         if (!dom.periodic[k]) continue;
         double& x = h.x[k];
@@ -1067,8 +1082,9 @@ void EdmEngine<D>::syncSlot(std::uint32_t s, double t) {
         x -= sh * L;
         p.image[i][k] += sh * L;
         // The box-frame position x - wrap L is unchanged, so the cell and the pending events stay valid.
-        link_[s].wrap[k] -= static_cast<std::int32_t>(sh);
+        ws[k] -= static_cast<std::int32_t>(sh);
     }
+    link_[s].wrap = packWraps(ws);
     p.x[i] = h.x;
     p.v[i] = h.v;
     if (!std::isfinite(norm2(h.x) + norm2(h.v) + norm2(p.w[i]))) {
@@ -1185,7 +1201,6 @@ void EdmEngine<D>::remove(std::size_t i, double t) {
     hot_[s].v = Vec<D>::zero();
     rec_[s].idx = kNil;
     rec_[s].cell = static_cast<std::uint32_t>(head_.size());
-    rec_[s].evCode = kNone << kTypeShift;
     rec_[s].coll = Candidate{};
     queue_.update(s, kNever);
     slotOf_[i] = kNil;
@@ -1205,10 +1220,10 @@ void EdmEngine<D>::add(std::size_t i, double t) {
     wrapIntoBox(i);
     const bool fz = p.frozen(i);
     hot_[s] = Hot{p.x[i], fz ? kNever : t, fz ? Vec<D>::zero() : p.v[i], p.radius[i]};
-    link_[s].wrap = Shift{};
+    link_[s].wrap = packWraps(Shift{});
     ++link_[s].count;
     rec_[s].coll = Candidate{};
-    rec_[s].tLast = -std::numeric_limits<double>::infinity();
+    if (tc_ > 0) tLast_[s] = -std::numeric_limits<double>::infinity();
     rec_[s].idx = static_cast<std::uint32_t>(i);
     insertCell(s, cellOf(p.x[i]));
     if (zoned_) zoneVolume_[zoneOfCell(rec_[s].cell)] += Particles<D>::volumeOf(hot_[s].r);
@@ -1300,7 +1315,7 @@ Vec<D> EdmEngine<D>::positionAt(std::size_t i, double t) const {
     Vec<D> x = posAt(hot_[s], t);
     for (int k = 0; k < D; ++k) {
         if (!w_.domain.periodic[k]) continue;
-        x[k] -= link_[s].wrap[k] * boxLen_[k];
+        x[k] -= wrapsOf(link_[s].wrap)[k] * boxLen_[k];
         const double lo = w_.domain.lo[k], L = boxLen_[k];
         x[k] -= std::floor((x[k] - lo) / L) * L;
     }
@@ -1322,7 +1337,7 @@ double EdmEngine<D>::nextEventTime() const {
 template <int D>
 std::size_t EdmEngine<D>::memoryBytes() const {
     auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-    return bytes(hot_) + bytes(link_) + bytes(rec_) + queue_.memoryBytes() + bytes(head_) + bytes(slotOf_) +
+    return bytes(hot_) + bytes(link_) + bytes(rec_) + bytes(tLast_) + queue_.memoryBytes() + bytes(head_) + bytes(slotOf_) +
            bytes(free_) + bytes(zoneVolume_) + bytes(centre_) + bytes(nbr_);
 }
 

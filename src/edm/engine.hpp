@@ -233,8 +233,24 @@ private:
     struct Link {
         std::uint32_t next;   // next slot in the same cell
         std::uint32_t count;  // collision counter (stale-event test)
-        Shift wrap;           // box-frame position = x - wrap * L on periodic axes
+        std::uint32_t wrap;   // box-frame position = x - wrap * L on periodic axes; packed, wrapsOf
     };
+    // Periodic wraps since the last synchronisation, kWrapBits per axis with a bias. One that would leave the
+    // field moves the whole box lengths from the stored position into Particles::image, as a synchronisation does.
+    static constexpr int kWrapBits = D == 3 ? 10 : 16;
+    static constexpr std::int32_t kWrapBias = 1 << (kWrapBits - 1), kWrapLimit = kWrapBias - 2;
+    static Shift wrapsOf(std::uint32_t packed) {
+        Shift w;
+        for (int k = 0; k < D; ++k)
+            w[k] = static_cast<std::int32_t>((packed >> (kWrapBits * k)) & ((1u << kWrapBits) - 1)) - kWrapBias;
+        return w;
+    }
+    static std::uint32_t packWraps(const Shift& w) {
+        std::uint32_t packed = 0;
+        for (int k = 0; k < D; ++k) packed |= static_cast<std::uint32_t>(w[k] + kWrapBias) << (kWrapBits * k);
+        return packed;
+    }
+    void setWraps(std::uint32_t s, Shift w);
     struct Candidate {
         double time = kNever;
         std::uint32_t code = kNone << kTypeShift;
@@ -294,18 +310,19 @@ private:
     // per slot
     std::vector<Hot> hot_;
     std::vector<Link> link_;
-    // What an event of the slot itself needs, in one cache line
+    // What an event of the slot itself needs (24 bytes). The pending event is coll when its time is the queue's
+    // time of the slot (coll wins a tie with the exit), otherwise the cell crossing (shell exit) through `exit`.
+    static constexpr std::uint32_t kCellBits = 29;
     struct Rec {
-        Candidate coll;        // earliest pair or wall event found by the last scan (code, partner's counter)
-        double tLast;          // time of the last collision (TC model)
-        std::uint32_t evCode;  // pending event: coll's code or a cell crossing (2 axis + up)
-        std::uint32_t cell;    // cell index
-        std::uint32_t prev;    // previous slot in the cell's list
-        std::uint32_t idx;     // slot -> World index
+        Candidate coll;                 // earliest pair or wall event found by the last scan (code, partner's counter)
+        std::uint32_t cell : kCellBits;  // cell index (free slot: head_.size())
+        std::uint32_t exit : 3;          // face of the cell crossing found by the last scan: 2 axis + up
+        std::uint32_t idx;               // slot -> World index
     };
     std::vector<Rec> rec_;
+    std::vector<double> tLast_;  // per slot: time of the last collision (only with the TC model)
     EventTree queue_;  // pending event times
-    // cell grid (linked lists with O(1) move)
+    // cell grid (singly linked lists: a crossing walks the old cell's few members to unlink)
     std::vector<std::uint32_t> head_;
     std::vector<std::int32_t> deltaFull_;                     // neighbour cell offsets (cells away from the faces)
     std::array<std::vector<std::int32_t>, 2 * D> deltaSide_;  // new neighbours after a crossing
