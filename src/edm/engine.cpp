@@ -115,7 +115,7 @@ void EdmEngine<D>::reset() {
     buildGrid();
     hot_.resize(n);
     link_.assign(n, Link{kNil, 0, packWraps(Shift{})});
-    rec_.assign(n, Rec{Candidate{}, 0, 0, 0});
+    rec_.assign(n, Rec{Kept{}, 0, 0, 0, 0});
     if (tc_ > 0)
         tLast_.assign(n, -std::numeric_limits<double>::infinity());
     else
@@ -198,7 +198,9 @@ void EdmEngine<D>::buildGrid() {
         edge *= 1.25;
     }
     std::uint32_t total = 1;
+    partialScans_ = true;
     for (int k = 0; k < D; ++k) {
+        if (w_.domain.periodic[k] && nCell_[k] < 7) partialScans_ = false;  // keptTime's minimum image
         cellW_[k] = boxLen_[k] > 0 ? boxLen_[k] / nCell_[k] : 1;
         stride_[k] = total;
         total *= static_cast<std::uint32_t>(nCell_[k]);
@@ -525,7 +527,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
     }
     Candidate best;
     if (axis >= 0) {
-        best = rec_[s].coll;
+        best = {keptTime(s, now), rec_[s].coll.code, rec_[s].coll.stamp};
     } else {
         for (std::size_t w = 0; w < w_.walls.size(); ++w) {
             const double t = wallTime(s, w, now);
@@ -639,9 +641,53 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
             j = nextJ;
         }
     }
-    rec_[s].coll = best;
-    rec_[s].exit = cross.code & 7u;
-    queue_.update(s, cross.better(best.time, best.code) ? best.time : cross.time);
+    setPending(s, best, cross);
+}
+
+template <int D>
+void EdmEngine<D>::setPending(std::uint32_t s, const Candidate& best, const Candidate& cross) {
+    Rec& r = rec_[s];
+    r.coll = Kept{best.code, best.stamp};
+    r.exit = cross.code & 7u;
+    const bool crossing = !cross.better(best.time, best.code);  // a tie goes to the pair or wall event
+    r.crossing = crossing;
+    queue_.update(s, crossing ? cross.time : best.time);
+}
+
+// Whether the best pair or wall event of slot s's last scan is still its best among the cells scanned then, so that a
+// crossing needs to scan only the new neighbour cells: its partner has not collided since (walls and frozen partners
+// never change), and its time can be recomputed (keptTime). Not for a frozen partner: under gravity its path relative
+// to s is a parabola, which can carry s far away and back, beyond the reach of the minimum image.
+template <int D>
+bool EdmEngine<D>::keepsColl(std::uint32_t s) const {
+    if (!partialScans_) return false;
+    const Kept& c = rec_[s].coll;
+    if ((c.code >> kTypeShift) != kPair) return true;
+    const std::uint32_t j = c.code & kIndexMask;
+    return link_[j].count == c.stamp && !frozen(j);
+}
+
+// The time of slot s's kept event, recomputed at a crossing (now) in the canonical form, so the same bits as when the
+// scan found it (only an invalid state, PHYSICS.md D.6, is decided afresh from the state now). The partner's periodic
+// image is the minimum image now: the pair approaches, so the two are no farther apart than when the scan found them
+// in neighbouring cells (sqrt(D) times two cell edges), which is less than half the box with 7 cells per axis.
+template <int D>
+double EdmEngine<D>::keptTime(std::uint32_t s, double now) const {
+    const Kept& c = rec_[s].coll;
+    const std::uint32_t k = c.code & kIndexMask;
+    switch (c.code >> kTypeShift) {
+        case kWall:
+            return wallTime(s, k, now);
+        case kPair: {
+            const Vec<D> d = posAt(hot_[s], now) - posAt(hot_[k], now);
+            Shift m{};
+            for (int a = 0; a < D; ++a)
+                if (w_.domain.periodic[a]) m[a] = -static_cast<std::int32_t>(std::nearbyint(d[a] / boxLen_[a]));
+            return pairTime(s, k, m, now, kNever);
+        }
+        default:
+            return kNever;
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -826,9 +872,7 @@ void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
         }
     }
     if (bestJ != kNil) best.stamp = link_[bestJ].count;
-    rec_[s].coll = best;
-    rec_[s].exit = cross.code & 7u;
-    queue_.update(s, cross.better(best.time, best.code) ? best.time : cross.time);
+    setPending(s, best, cross);
 }
 
 template <int D>
@@ -1022,7 +1066,7 @@ void EdmEngine<D>::processNext() {
     const double t = queue_.topTime();
     countEvent(t);
     const Rec& rs = rec_[s];
-    const std::uint32_t code = t == rs.coll.time ? rs.coll.code : (kCell << kTypeShift) | rs.exit;
+    const std::uint32_t code = rs.crossing ? (kCell << kTypeShift) | rs.exit : rs.coll.code;
     const std::uint32_t k = code & kIndexMask;
     switch (code >> kTypeShift) {
         case kPair:
@@ -1051,9 +1095,7 @@ void EdmEngine<D>::processNext() {
             const bool up = k & 1;
             crossCell(s, axis, up);
             // The earlier scan's best pair or wall event stays valid unless its partner collided since.
-            const Candidate& c = rec_[s].coll;
-            const bool valid = (c.code >> kTypeShift) != kPair || link_[c.code & kIndexMask].count == c.stamp;
-            if (valid)
+            if (keepsColl(s))
                 predict(s, t, axis, up ? 1 : -1);
             else
                 predict(s, t);
@@ -1201,7 +1243,8 @@ void EdmEngine<D>::remove(std::size_t i, double t) {
     hot_[s].v = Vec<D>::zero();
     rec_[s].idx = kNil;
     rec_[s].cell = static_cast<std::uint32_t>(head_.size());
-    rec_[s].coll = Candidate{};
+    rec_[s].coll = Kept{};
+    rec_[s].crossing = 0;
     queue_.update(s, kNever);
     slotOf_[i] = kNil;
     free_.push_back(s);
@@ -1222,7 +1265,7 @@ void EdmEngine<D>::add(std::size_t i, double t) {
     hot_[s] = Hot{p.x[i], fz ? kNever : t, fz ? Vec<D>::zero() : p.v[i], p.radius[i]};
     link_[s].wrap = packWraps(Shift{});
     ++link_[s].count;
-    rec_[s].coll = Candidate{};
+    rec_[s].coll = Kept{};
     if (tc_ > 0) tLast_[s] = -std::numeric_limits<double>::infinity();
     rec_[s].idx = static_cast<std::uint32_t>(i);
     insertCell(s, cellOf(p.x[i]));

@@ -268,6 +268,9 @@ private:
     void removeCell(std::uint32_t s);
     void resort();
     void predict(std::uint32_t s, double now, int axis = -1, int dir = 0);
+    void setPending(std::uint32_t s, const Candidate& best, const Candidate& cross);
+    bool keepsColl(std::uint32_t s) const;
+    double keptTime(std::uint32_t s, double now) const;
     void predictShell(std::uint32_t s, double now);
     double candidateTime(const Hot& hs, std::uint32_t s, std::uint32_t j, const Shift& m, double now,
                          double bestTime) const;
@@ -310,13 +313,18 @@ private:
     // per slot
     std::vector<Hot> hot_;
     std::vector<Link> link_;
-    // What an event of the slot itself needs (24 bytes). The pending event is coll when its time is the queue's
-    // time of the slot (coll wins a tie with the exit), otherwise the cell crossing (shell exit) through `exit`.
-    static constexpr std::uint32_t kCellBits = 29;
+    // What an event of the slot itself needs (16 bytes). The pending event's time is the queue's; the time of
+    // coll is not kept: while the crossing is pending it is recomputed when needed (keptTime).
+    static constexpr std::uint32_t kCellBits = 28;
+    struct Kept {
+        std::uint32_t code = kNone << kTypeShift;
+        std::uint32_t stamp = 0;
+    };
     struct Rec {
-        Candidate coll;                 // earliest pair or wall event found by the last scan (code, partner's counter)
+        Kept coll;  // earliest pair or wall event found by the last scan: code, partner's counter
         std::uint32_t cell : kCellBits;  // cell index (free slot: head_.size())
-        std::uint32_t exit : 3;          // face of the cell crossing found by the last scan: 2 axis + up
+        std::uint32_t exit : 3;          // face of the cell crossing (shell exit) found by the last scan: 2 axis + up
+        std::uint32_t crossing : 1;      // the pending event is that crossing, not coll
         std::uint32_t idx;               // slot -> World index
     };
     std::vector<Rec> rec_;
@@ -329,6 +337,7 @@ private:
     std::array<int, D> nCell_{};
     std::array<std::uint32_t, D> stride_{};
     Vec<D> cellW_;
+    bool partialScans_ = true;  // crossings scan only the new neighbour cells (docs/edm.md: needs 7 cells per periodic axis)
 
     // Neighbour shells (shells_): per slot the box-frame centre of its cube (edge 2 shellHalf_) and a row of rowLen_
     // words in nbr_: the count, then the neighbours, each a slot with the periodic image of the neighbour's centre
