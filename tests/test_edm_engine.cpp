@@ -406,6 +406,57 @@ TEST(EdmEngine, SameRunWithoutTdmState) {
     EXPECT_THROW({ TdmEngine<3> t(lean, TdmSettings{}); }, std::invalid_argument);
 }
 
+// With holdState the engine is the only holder of positions, velocities and radii between synchronisations: the
+// World's arrays are empty while events run and come back at synchronise, with the same run bit for bit (several
+// windows of advanceEvents, frozen particles with a velocity of their own, periodic wraps into Particles::image).
+TEST(EdmEngine, SameRunHoldingState) {
+    GasSpec g;
+    g.n = 216;
+    g.phi = 0.3;
+    g.spin = 1;
+    g.seed = 11;
+    g.gravity = 1;
+    World<3> shared = makeGas<3>(g, edmContact(0.9, 0.5, 0.4));
+    for (int i = 0; i < 6; ++i) {
+        shared.particles.flags[i] |= kFrozen;
+        shared.particles.invMass[i] = 0;
+        shared.particles.invInertia[i] = 0;
+        shared.particles.v[i] = Vec<3>{{0.1 * i, 0, 0}};
+    }
+    shared.particles.dropTdmState();
+    World<3> held = shared;
+    EdmSettings s;
+    EdmEngine<3> a(shared, s);
+    s.holdState = true;
+    EdmEngine<3> b(held, s);
+    for (int window = 1; window <= 4; ++window) {
+        const double t = 0.5 * window;
+        a.advanceEvents(t);
+        b.advanceEvents(t);
+        EXPECT_FALSE(held.particles.hasMotion());
+        EXPECT_TRUE(held.particles.x.empty() && held.particles.v.empty() && held.particles.radius.empty());
+        EXPECT_EQ(held.particles.size(), shared.particles.size());
+        if (window % 2 == 0) continue;  // two windows without a synchronisation
+        a.synchronise(t);
+        b.synchronise(t);
+        ASSERT_TRUE(held.particles.hasMotion());
+        for (std::size_t i = 0; i < shared.particles.size(); ++i) {
+            EXPECT_EQ(shared.particles.x[i], held.particles.x[i]);
+            EXPECT_EQ(shared.particles.v[i], held.particles.v[i]);
+            EXPECT_EQ(shared.particles.w[i], held.particles.w[i]);
+            EXPECT_EQ(shared.particles.image[i], held.particles.image[i]);
+            EXPECT_EQ(shared.particles.radius[i], held.particles.radius[i]);
+        }
+    }
+    EXPECT_GT(a.collisions(), 1000u);
+    EXPECT_EQ(a.collisions(), b.collisions());
+    EXPECT_THROW(b.reset(), std::logic_error);  // the World's arrays are with the engine
+    b.synchronise(held.time);
+    b.reset();
+    s.firstParticle = 1;
+    EXPECT_THROW({ EdmEngine<3> c(shared, s); }, std::invalid_argument);
+}
+
 TEST(EdmEngine, RejectsBadSettings) {
     World<3> w = bouncingBall(0.5);
     EdmSettings s;

@@ -47,6 +47,8 @@ EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings) : w_(world
     if (s_.maxEventRate < 0) throw std::invalid_argument("event-driven engine: maxEventRate must be >= 0");
     if (s_.cellSize < 0) throw std::invalid_argument("event-driven engine: cellSize must be >= 0");
     if (!(s_.shell >= 0)) throw std::invalid_argument("event-driven engine: shell must be >= 0");
+    if (s_.holdState && s_.firstParticle > 0)
+        throw std::invalid_argument("event-driven engine: holdState needs every particle (firstParticle = 0)");
     tcRef_ = s_.tcTime > 0 ? s_.tcTime : cs.contactTime;
     tc_ = (s_.tcModel && tcRef_ > 0) ? tcRef_ : 0;
     g_ = w_.domain.gravity;
@@ -70,6 +72,7 @@ EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings) : w_(world
 template <int D>
 void EdmEngine<D>::reset() {
     Particles<D>& p = w_.particles;
+    if (!p.hasMotion()) throw std::logic_error("event-driven engine: reset while it holds the state (synchronise first)");
     const std::size_t n = p.size();
     const std::size_t first = std::min(s_.firstParticle, n);
     if (n >= (1u << kTypeShift)) throw std::invalid_argument("event-driven engine: too many particles");
@@ -129,7 +132,8 @@ void EdmEngine<D>::reset() {
             rec_[i].cell = freeCell;
             continue;
         }
-        hot_[i] = Hot{p.x[i], fz ? kNever : w_.time, fz ? Vec<D>::zero() : p.v[i], p.radius[i]};
+        // A frozen particle's velocity is taken as zero (posAt, velAt); its slot keeps the World's for holdState.
+        hot_[i] = Hot{p.x[i], fz ? kNever : w_.time, p.v[i], p.radius[i]};
         rec_[i].idx = i;
         rec_[i].cell = cellOf(p.x[i]);
     }
@@ -319,12 +323,16 @@ void EdmEngine<D>::resort() {
     for (std::size_t k = 0; k < n; ++k) renumber(rec_[k].coll.code);
     queue_.build(times);
     linkCells();
-    slotOf_.assign(w_.particles.size(), kNil);
+    // The World-to-slot table serves the hybrid's questions about single particles; a run with holdState asks none.
+    if (s_.holdState)
+        std::vector<std::uint32_t>().swap(slotOf_);
+    else
+        slotOf_.assign(w_.particles.size(), kNil);
     free_.clear();
     for (std::uint32_t k = static_cast<std::uint32_t>(n); k-- > 0;) {
         if (rec_[k].idx == kNil)
             free_.push_back(k);
-        else
+        else if (!slotOf_.empty())
             slotOf_[rec_[k].idx] = k;
     }
     sortedAt_ = events_;
@@ -1109,9 +1117,24 @@ void EdmEngine<D>::processNext() {
 
 template <int D>
 void EdmEngine<D>::syncSlot(std::uint32_t s, double t) {
+    advance(s, t);
+    storeSlot(s);
+    const Particles<D>& p = w_.particles;
+    const Hot& h = hot_[s];
+    const std::uint32_t i = rec_[s].idx;
+    if (!std::isfinite(norm2(h.x) + norm2(h.v) + norm2(p.w[i]))) {
+        std::ostringstream msg;
+        msg << "event-driven engine: particle " << p.id[i] << " (index " << i << ") has a non-finite state at t = " << t
+            << " s";
+        throw SimulationError(msg.str());
+    }
+}
+
+// Writes moving slot s's stored state (at its clock) to the World, its position wrapped into the box.
+template <int D>
+void EdmEngine<D>::storeSlot(std::uint32_t s) {
     Particles<D>& p = w_.particles;
     const Domain<D>& dom = w_.domain;
-    advance(s, t);
     Hot& h = hot_[s];
     const std::uint32_t i = rec_[s].idx;
     Shift ws = wrapsOf(link_[s].wrap);
@@ -1129,19 +1152,44 @@ void EdmEngine<D>::syncSlot(std::uint32_t s, double t) {
     link_[s].wrap = packWraps(ws);
     p.x[i] = h.x;
     p.v[i] = h.v;
-    if (!std::isfinite(norm2(h.x) + norm2(h.v) + norm2(p.w[i]))) {
-        std::ostringstream msg;
-        msg << "event-driven engine: particle " << p.id[i] << " (index " << i << ") has a non-finite state at t = " << t
-            << " s";
-        throw SimulationError(msg.str());
-    }
 }
 
 template <int D>
 void EdmEngine<D>::synchronise(double t) {
-    for (std::uint32_t s = 0; s < hot_.size(); ++s)
-        if (!frozen(s)) syncSlot(s, t);
+    Particles<D>& p = w_.particles;
+    const bool restore = !p.hasMotion();
+    if (restore) p.restoreMotion();
+    for (std::uint32_t s = 0; s < hot_.size(); ++s) {
+        const std::uint32_t i = rec_[s].idx;
+        if (i == kNil) continue;
+        if (!frozen(s)) {
+            syncSlot(s, t);
+        } else if (restore) {
+            p.x[i] = hot_[s].x;
+            p.v[i] = hot_[s].v;
+        }
+        if (restore) p.radius[i] = hot_[s].r;
+    }
     w_.time = t;
+}
+
+// After an error in advanceEvents: the World gets its arrays back with every particle's state at its own clock.
+template <int D>
+void EdmEngine<D>::putBackState() {
+    Particles<D>& p = w_.particles;
+    if (p.hasMotion()) return;
+    p.restoreMotion();
+    for (std::uint32_t s = 0; s < hot_.size(); ++s) {
+        const std::uint32_t i = rec_[s].idx;
+        if (i == kNil) continue;
+        if (!frozen(s)) {
+            storeSlot(s);
+        } else {
+            p.x[i] = hot_[s].x;
+            p.v[i] = hot_[s].v;
+        }
+        p.radius[i] = hot_[s].r;
+    }
 }
 
 template <int D>
@@ -1221,7 +1269,13 @@ void EdmEngine<D>::advanceTo(double t) {
 template <int D>
 void EdmEngine<D>::advanceEvents(double t) {
     if (s_.reference) throw std::logic_error("event-driven engine: advanceEvents in reference mode");
-    while (queue_.size() > 0 && queue_.topTime() < t) processNext();
+    if (s_.holdState && w_.particles.hasMotion()) w_.particles.releaseMotion();
+    try {
+        while (queue_.size() > 0 && queue_.topTime() < t) processNext();
+    } catch (...) {
+        putBackState();
+        throw;
+    }
     // Particles diffuse away from their sorted neighbours; re-sort after ~20 events per particle.
     if (events_ - sortedAt_ > 20 * static_cast<std::uint64_t>(std::max<std::size_t>(nLive_, 1))) resort();
 }
@@ -1231,6 +1285,7 @@ void EdmEngine<D>::advanceEvents(double t) {
 
 template <int D>
 void EdmEngine<D>::remove(std::size_t i, double t) {
+    if (s_.holdState) throw std::logic_error("event-driven engine: particles join and leave only without holdState");
     if (!owns(i)) throw std::logic_error("event-driven engine: remove of a particle it does not own");
     const std::uint32_t s = slotOf_[i];
     const bool fz = frozen(s);
@@ -1255,6 +1310,7 @@ void EdmEngine<D>::remove(std::size_t i, double t) {
 template <int D>
 void EdmEngine<D>::add(std::size_t i, double t) {
     Particles<D>& p = w_.particles;
+    if (s_.holdState) throw std::logic_error("event-driven engine: particles join and leave only without holdState");
     if (owns(i) || i >= p.size()) throw std::logic_error("event-driven engine: add of an owned or unknown particle");
     if (free_.empty()) throw std::logic_error("event-driven engine: no free slot");
     if (p.radius[i] > rmax_ * (1 + 1e-12)) throw std::logic_error("event-driven engine: particle larger than the grid");
@@ -1308,6 +1364,7 @@ void EdmEngine<D>::add(std::size_t i, double t) {
 template <int D>
 void EdmEngine<D>::swapIndices(std::size_t i, std::size_t j) {
     if (i == j) return;
+    if (s_.holdState) throw std::logic_error("event-driven engine: swapIndices needs holdState off");
     std::swap(slotOf_[i], slotOf_[j]);
     if (slotOf_[i] != kNil) rec_[slotOf_[i]].idx = static_cast<std::uint32_t>(i);
     if (slotOf_[j] != kNil) rec_[slotOf_[j]].idx = static_cast<std::uint32_t>(j);

@@ -40,6 +40,12 @@ struct EdmSettings {
     /// loop). 0: 1000 / tcTime (also when the TC model is off); without any TC time 10^4 u / d_min, where u is
     /// the largest of the rms particle speed, sqrt(|g| d_min) and the fastest wall speed at the start.
     double maxEventRate = 0;
+    /// A pure event-driven run (no other engine on the store, firstParticle = 0): between synchronisations the
+    /// engine holds the only copy of positions, velocities and radii. advanceEvents releases the World's
+    /// (Particles::releaseMotion) and synchronise writes them back; reset() needs them back first. The engine then
+    /// keeps no World-to-slot table: the questions about single particles (owns, add, remove, swapIndices,
+    /// positionAt, velocityAt, collisionCount, cellOfParticle) are the hybrid's, and unavailable.
+    bool holdState = false;
     /// World index of the first particle this engine owns. Those before it belong to another engine (the
     /// time-driven one of a hybrid run) and are invisible here; particles join and leave with add() and remove().
     std::size_t firstParticle = 0;
@@ -104,9 +110,11 @@ public:
     void advanceTo(double t);
 
     /// Processes all events before t without bringing the particles to t (their clocks stay where their last
-    /// event left them); the World's copy of this engine's particles is stale until synchronise().
+    /// event left them); the World's copy of this engine's particles is stale (with EdmSettings::holdState: absent)
+    /// until synchronise(). If it throws, a held state is put back as it is, each particle at its own clock.
     void advanceEvents(double t);
     /// Brings every particle of this engine to time t and writes its state to the World; world.time = t.
+    /// With EdmSettings::holdState it also gives the World back its positions, velocities and radii.
     void synchronise(double t);
 
     // ---- particles joining and leaving (hybrid runs) ----
@@ -291,6 +299,8 @@ private:
     void crossCell(std::uint32_t s, int axis, bool up);
     void advance(std::uint32_t s, double t);
     void syncSlot(std::uint32_t s, double t);
+    void storeSlot(std::uint32_t s);
+    void putBackState();
     std::uint32_t zoneOfCell(std::uint32_t c) const;
     void countEvent(double t);
     Vec<D> posAt(const Hot& h, double t) const;
