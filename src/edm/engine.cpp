@@ -493,6 +493,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
         return;
     }
     const Domain<D>& dom = w_.domain;
+    queue_.prefetchPath(s);
     const Hot& hs = hot_[s];
     const Shift ws = wrapsOf(link_[s].wrap);
     // Cell coordinates, the faces s can leave through, and the neighbour cells per axis. The exit is computed from
@@ -582,6 +583,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
         __builtin_prefetch(&hot_[heads[q]]);
         __builtin_prefetch(&link_[heads[q]]);
     }
+    queue_.prefetchRivals(s);
     // The canonical form of pairTime, written out for speed: the older of the two states is extrapolated to the
     // other's clock (an extrapolation by zero leaves a state unchanged, so skipping it gives the same bits).
     // Candidates later than the best pair or wall event so far are skipped before the square root, but never
