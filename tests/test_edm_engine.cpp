@@ -267,6 +267,31 @@ TEST(EdmEngine, PeriodicWrapRecordsImages) {
     EXPECT_EQ(eng.collisions(), 0u);
 }
 
+// The wraps since the last synchronisation have 10 bits per axis in 3D: a particle that crosses a periodic face more
+// than 510 times between synchronisations moves whole box lengths from its stored position into Particles::image.
+TEST(EdmEngine, ManyWrapsBetweenSynchronisations) {
+    World<3> w;
+    w.contact = edmContact(1.0);
+    w.domain.lo = Vec<3>::zero();
+    w.domain.hi = Vec<3>{{2, 2, 2}};
+    w.domain.periodic = {true, true, true};
+    w.particles.add(Vec<3>{{0.5, 0.5, 0.5}}, Vec<3>{{3.1, -2.3, 0.7}}, Ang<3>::zero(), 0.25, 1.0, 0, 0);
+    EdmEngine<3> eng(w, EdmSettings{});
+    const double t = 800;  // 1240 wraps along x, 920 along y
+    eng.advanceEvents(t);
+    eng.synchronise(t);
+    const Vec<3> unwrapped = w.particles.x[0] + w.particles.image[0];
+    EXPECT_NEAR(unwrapped[0], 0.5 + 3.1 * t, 1e-9);
+    EXPECT_NEAR(unwrapped[1], 0.5 - 2.3 * t, 1e-9);
+    EXPECT_NEAR(unwrapped[2], 0.5 + 0.7 * t, 1e-9);
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_GE(w.particles.x[0][k], 0);
+        EXPECT_LT(w.particles.x[0][k], 2);
+    }
+    EXPECT_EQ(eng.positionAt(0, t), w.particles.x[0]);
+    EXPECT_GT(eng.stats().cellCrossings, 2000u);
+}
+
 TEST(EdmEngine, PeriodicImagesCollide) {
     // two particles that meet only through the periodic boundary
     World<3> w;
