@@ -248,8 +248,8 @@ void EdmEngine<D>::insertCell(std::uint32_t s, std::uint32_t c) {
     head_[c] = s;
 }
 
-// A cell holds about one particle (two at most in most cells), so walking its list costs less than a back link
-// per slot would: no predecessor to keep, 4 bytes per particle fewer.
+// A cell holds a few particles (about one with the default edge of one diameter), so walking its list costs less than
+// a back link per slot would: no predecessor to keep, 4 bytes per particle fewer.
 template <int D>
 void EdmEngine<D>::removeCell(std::uint32_t s) {
     std::uint32_t* at = &head_[rec_[s].cell];
@@ -678,7 +678,8 @@ bool EdmEngine<D>::keepsColl(std::uint32_t s) const {
 }
 
 // The time of slot s's kept event, recomputed at a crossing (now) in the canonical form, so the same bits as when the
-// scan found it (only an invalid state, PHYSICS.md D.6, is decided afresh from the state now). The partner's periodic
+// scan found it, unless a synchronisation has rounded the stored states since or the state is invalid (PHYSICS.md
+// D.6: decided afresh from the state now); docs/edm.md, "Canonical arithmetic". The partner's periodic
 // image is the minimum image now: the pair approaches, so the two are no farther apart than when the scan found them
 // in neighbouring cells (sqrt(D) times two cell edges), which is less than half the box with 7 cells per axis.
 template <int D>
