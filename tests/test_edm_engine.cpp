@@ -124,6 +124,26 @@ TEST(EdmEngine, MatchesReference3DPeriodicRoughElastic) {
     compareWithReference<3>(makeGas<3>(g, edmContact(1.0, 0.0, 1.0)), s, 10000);
 }
 
+// Seven or more cells per periodic axis: a crossing scans only the new neighbour cells and recomputes the time of the
+// event it keeps (with the partner's minimum image); with fewer cells it scans them all.
+TEST(EdmEngine, MatchesReference3DPeriodicPartialScans) {
+    GasSpec g;
+    g.n = 110;
+    g.phi = 0.15;
+    g.spin = 1;
+    g.seed = 6;
+    EdmSettings s;
+    s.tcModel = false;
+    s.tangential = EdmSettings::Tangential::Constant;
+    World<3> w = makeGas<3>(g, edmContact(1.0, 0.0, 1.0));
+    {
+        World<3> probe = w;
+        const EdmEngine<3> eng(probe, s);
+        for (int k = 0; k < 3; ++k) ASSERT_GE(eng.cellDims()[k], 7);
+    }
+    compareWithReference<3>(w, s, 4000);
+}
+
 TEST(EdmEngine, MatchesReference2DWalledGravity) {
     GasSpec g;
     g.n = 50;
@@ -245,6 +265,31 @@ TEST(EdmEngine, PeriodicWrapRecordsImages) {
     }
     EXPECT_GT(eng.stats().cellCrossings, 50u);
     EXPECT_EQ(eng.collisions(), 0u);
+}
+
+// The wraps since the last synchronisation have 10 bits per axis in 3D: a particle that crosses a periodic face more
+// than 510 times between synchronisations moves whole box lengths from its stored position into Particles::image.
+TEST(EdmEngine, ManyWrapsBetweenSynchronisations) {
+    World<3> w;
+    w.contact = edmContact(1.0);
+    w.domain.lo = Vec<3>::zero();
+    w.domain.hi = Vec<3>{{2, 2, 2}};
+    w.domain.periodic = {true, true, true};
+    w.particles.add(Vec<3>{{0.5, 0.5, 0.5}}, Vec<3>{{3.1, -2.3, 0.7}}, Ang<3>::zero(), 0.25, 1.0, 0, 0);
+    EdmEngine<3> eng(w, EdmSettings{});
+    const double t = 800;  // 1240 wraps along x, 920 along y
+    eng.advanceEvents(t);
+    eng.synchronise(t);
+    const Vec<3> unwrapped = w.particles.x[0] + w.particles.image[0];
+    EXPECT_NEAR(unwrapped[0], 0.5 + 3.1 * t, 1e-9);
+    EXPECT_NEAR(unwrapped[1], 0.5 - 2.3 * t, 1e-9);
+    EXPECT_NEAR(unwrapped[2], 0.5 + 0.7 * t, 1e-9);
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_GE(w.particles.x[0][k], 0);
+        EXPECT_LT(w.particles.x[0][k], 2);
+    }
+    EXPECT_EQ(eng.positionAt(0, t), w.particles.x[0]);
+    EXPECT_GT(eng.stats().cellCrossings, 2000u);
 }
 
 TEST(EdmEngine, PeriodicImagesCollide) {
@@ -384,6 +429,57 @@ TEST(EdmEngine, SameRunWithoutTdmState) {
     EXPECT_TRUE(lean.particles.f.empty());
     lean.particles.swapEntries(0, lean.particles.size() - 1);
     EXPECT_THROW({ TdmEngine<3> t(lean, TdmSettings{}); }, std::invalid_argument);
+}
+
+// With holdState the engine is the only holder of positions, velocities and radii between synchronisations: the
+// World's arrays are empty while events run and come back at synchronise, with the same run bit for bit (several
+// windows of advanceEvents, frozen particles with a velocity of their own, periodic wraps into Particles::image).
+TEST(EdmEngine, SameRunHoldingState) {
+    GasSpec g;
+    g.n = 216;
+    g.phi = 0.3;
+    g.spin = 1;
+    g.seed = 11;
+    g.gravity = 1;
+    World<3> shared = makeGas<3>(g, edmContact(0.9, 0.5, 0.4));
+    for (int i = 0; i < 6; ++i) {
+        shared.particles.flags[i] |= kFrozen;
+        shared.particles.invMass[i] = 0;
+        shared.particles.invInertia[i] = 0;
+        shared.particles.v[i] = Vec<3>{{0.1 * i, 0, 0}};
+    }
+    shared.particles.dropTdmState();
+    World<3> held = shared;
+    EdmSettings s;
+    EdmEngine<3> a(shared, s);
+    s.holdState = true;
+    EdmEngine<3> b(held, s);
+    for (int window = 1; window <= 4; ++window) {
+        const double t = 0.5 * window;
+        a.advanceEvents(t);
+        b.advanceEvents(t);
+        EXPECT_FALSE(held.particles.hasMotion());
+        EXPECT_TRUE(held.particles.x.empty() && held.particles.v.empty() && held.particles.radius.empty());
+        EXPECT_EQ(held.particles.size(), shared.particles.size());
+        if (window % 2 == 0) continue;  // two windows without a synchronisation
+        a.synchronise(t);
+        b.synchronise(t);
+        ASSERT_TRUE(held.particles.hasMotion());
+        for (std::size_t i = 0; i < shared.particles.size(); ++i) {
+            EXPECT_EQ(shared.particles.x[i], held.particles.x[i]);
+            EXPECT_EQ(shared.particles.v[i], held.particles.v[i]);
+            EXPECT_EQ(shared.particles.w[i], held.particles.w[i]);
+            EXPECT_EQ(shared.particles.image[i], held.particles.image[i]);
+            EXPECT_EQ(shared.particles.radius[i], held.particles.radius[i]);
+        }
+    }
+    EXPECT_GT(a.collisions(), 1000u);
+    EXPECT_EQ(a.collisions(), b.collisions());
+    EXPECT_THROW(b.reset(), std::logic_error);  // the World's arrays are with the engine
+    b.synchronise(held.time);
+    b.reset();
+    s.firstParticle = 1;
+    EXPECT_THROW({ EdmEngine<3> c(shared, s); }, std::invalid_argument);
 }
 
 TEST(EdmEngine, RejectsBadSettings) {

@@ -61,7 +61,7 @@ struct Particles {
     /// event-driven engine (PHYSICS.md A); in a pure run one engine owns them all (the default: every particle).
     std::size_t nTdm = static_cast<std::size_t>(-1);
 
-    std::size_t size() const { return x.size(); }
+    std::size_t size() const { return id.size(); }
     /// Whether f, torque and angle are kept. Only the time-driven engine reads them (the hybrid too, for its
     /// time-driven particles); a pure event-driven run applies impulses, not forces, and nothing reads the
     /// accumulated rotation of a disk or sphere, so it drops them (dropTdmState): 72 of the 211 bytes per sphere.
@@ -73,7 +73,26 @@ struct Particles {
         std::vector<Ang<D>>().swap(torque);
         std::vector<Ang<D>>().swap(angle);
     }
-    std::size_t tdmCount() const { return nTdm < x.size() ? nTdm : x.size(); }
+    std::size_t tdmCount() const { return nTdm < size() ? nTdm : size(); }
+
+    /// Whether x, v and radius are in the store. A pure event-driven run keeps them only in its engine between
+    /// synchronisations (EdmSettings::holdState), where they sit together in one record per particle, and releases
+    /// them here: 56 bytes per sphere that would otherwise be held twice. While they are released nothing may read
+    /// them, and particles are neither added, swapped nor permuted.
+    bool hasMotion() const { return motion_; }
+    void releaseMotion() {
+        motion_ = false;
+        std::vector<Vec<D>>().swap(x);
+        std::vector<Vec<D>>().swap(v);
+        std::vector<double>().swap(radius);
+    }
+    /// Gives x, v and radius their size back (the values are the holder's to write).
+    void restoreMotion() {
+        motion_ = true;
+        x.resize(size());
+        v.resize(size());
+        radius.resize(size());
+    }
 
     /// Appends one particle of given density [kg/m^D-volume]; mass from radius and density.
     std::size_t add(const Vec<D>& pos, const Vec<D>& vel, const Ang<D>& spin, double r, double density,
@@ -190,6 +209,7 @@ struct Particles {
 
 private:
     bool tdmState_ = true;
+    bool motion_ = true;
 };
 
 }  // namespace haet

@@ -47,6 +47,8 @@ EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings) : w_(world
     if (s_.maxEventRate < 0) throw std::invalid_argument("event-driven engine: maxEventRate must be >= 0");
     if (s_.cellSize < 0) throw std::invalid_argument("event-driven engine: cellSize must be >= 0");
     if (!(s_.shell >= 0)) throw std::invalid_argument("event-driven engine: shell must be >= 0");
+    if (s_.holdState && s_.firstParticle > 0)
+        throw std::invalid_argument("event-driven engine: holdState needs every particle (firstParticle = 0)");
     tcRef_ = s_.tcTime > 0 ? s_.tcTime : cs.contactTime;
     tc_ = (s_.tcModel && tcRef_ > 0) ? tcRef_ : 0;
     g_ = w_.domain.gravity;
@@ -70,6 +72,7 @@ EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings) : w_(world
 template <int D>
 void EdmEngine<D>::reset() {
     Particles<D>& p = w_.particles;
+    if (!p.hasMotion()) throw std::logic_error("event-driven engine: reset while it holds the state (synchronise first)");
     const std::size_t n = p.size();
     const std::size_t first = std::min(s_.firstParticle, n);
     if (n >= (1u << kTypeShift)) throw std::invalid_argument("event-driven engine: too many particles");
@@ -114,8 +117,12 @@ void EdmEngine<D>::reset() {
     // Slots in World order first, then sorted cell by cell.
     buildGrid();
     hot_.resize(n);
-    link_.assign(n, Link{kNil, 0, Shift{}});
-    rec_.assign(n, Rec{Candidate{}, -std::numeric_limits<double>::infinity(), kNone << kTypeShift, 0, kNil, 0});
+    link_.assign(n, Link{kNil, 0, packWraps(Shift{})});
+    rec_.assign(n, Rec{Kept{}, 0, 0, 0, 0});
+    if (tc_ > 0)
+        tLast_.assign(n, -std::numeric_limits<double>::infinity());
+    else
+        std::vector<double>().swap(tLast_);
     const std::uint32_t freeCell = static_cast<std::uint32_t>(head_.size());
     for (std::uint32_t i = 0; i < n; ++i) {
         const bool fz = p.frozen(i);
@@ -125,7 +132,8 @@ void EdmEngine<D>::reset() {
             rec_[i].cell = freeCell;
             continue;
         }
-        hot_[i] = Hot{p.x[i], fz ? kNever : w_.time, fz ? Vec<D>::zero() : p.v[i], p.radius[i]};
+        // A frozen particle's velocity is taken as zero (posAt, velAt); its slot keeps the World's for holdState.
+        hot_[i] = Hot{p.x[i], fz ? kNever : w_.time, p.v[i], p.radius[i]};
         rec_[i].idx = i;
         rec_[i].cell = cellOf(p.x[i]);
     }
@@ -179,8 +187,10 @@ void EdmEngine<D>::buildGrid() {
                                               "plus the neighbour shell"
                                             : "event-driven engine: cellSize is smaller than the largest diameter");
     if (!(edge > 0)) edge = 1;
-    // At most max(2^20, 8 N) cells: a huge open box with few particles gets larger cells.
-    const double maxCells = std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size()));
+    // At most max(2^20, 8 N) cells: a huge open box with few particles gets larger cells. Below 2^29 - 1 in any
+    // case: Rec::cell has 29 bits and the free slots' cell is the one past the last.
+    const double maxCells = std::min(double((1u << kCellBits) - 2),
+                                     std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size())));
     for (;;) {
         double total = 1;
         for (int k = 0; k < D; ++k) {
@@ -192,7 +202,9 @@ void EdmEngine<D>::buildGrid() {
         edge *= 1.25;
     }
     std::uint32_t total = 1;
+    partialScans_ = true;
     for (int k = 0; k < D; ++k) {
+        if (w_.domain.periodic[k] && nCell_[k] < 7) partialScans_ = false;  // keptTime's minimum image
         cellW_[k] = boxLen_[k] > 0 ? boxLen_[k] / nCell_[k] : 1;
         stride_[k] = total;
         total *= static_cast<std::uint32_t>(nCell_[k]);
@@ -232,20 +244,30 @@ std::uint32_t EdmEngine<D>::cellOf(const Vec<D>& x) const {
 template <int D>
 void EdmEngine<D>::insertCell(std::uint32_t s, std::uint32_t c) {
     rec_[s].cell = c;
-    rec_[s].prev = kNil;
     link_[s].next = head_[c];
-    if (head_[c] != kNil) rec_[head_[c]].prev = s;
     head_[c] = s;
 }
 
+// A cell holds a few particles (about one with the default edge of one diameter), so walking its list costs less than
+// a back link per slot would: no predecessor to keep, 4 bytes per particle fewer.
 template <int D>
 void EdmEngine<D>::removeCell(std::uint32_t s) {
-    const std::uint32_t nx = link_[s].next;
-    if (rec_[s].prev != kNil)
-        link_[rec_[s].prev].next = nx;
-    else
-        head_[rec_[s].cell] = nx;
-    if (nx != kNil) rec_[nx].prev = rec_[s].prev;
+    std::uint32_t* at = &head_[rec_[s].cell];
+    while (*at != s) at = &link_[*at].next;
+    *at = link_[s].next;
+}
+
+template <int D>
+void EdmEngine<D>::setWraps(std::uint32_t s, Shift w) {
+    for (int k = 0; k < D; ++k) {
+        if (std::abs(w[k]) <= kWrapLimit) continue;
+        // Whole box lengths from the stored position into Particles::image, as syncSlot does; the box-frame
+        // position and so the cell and the pending events stay (the stored x is rounded, as at a synchronisation).
+        hot_[s].x[k] -= w[k] * boxLen_[k];
+        w_.particles.image[rec_[s].idx][k] += w[k] * boxLen_[k];
+        w[k] = 0;
+    }
+    link_[s].wrap = packWraps(w);
 }
 
 template <int D>
@@ -278,6 +300,7 @@ void EdmEngine<D>::resort() {
     permute(hot_);
     permute(link_);
     permute(rec_);
+    if (!tLast_.empty()) permute(tLast_);
     if (shells_) {
         permute(centre_);
         if (!nbr_.empty()) {
@@ -297,18 +320,19 @@ void EdmEngine<D>::resort() {
     auto renumber = [&](std::uint32_t& code) {
         if ((code >> kTypeShift) == kPair) code = (kPair << kTypeShift) | newSlot[code & kIndexMask];
     };
-    for (std::size_t k = 0; k < n; ++k) {
-        renumber(rec_[k].evCode);
-        renumber(rec_[k].coll.code);
-    }
+    for (std::size_t k = 0; k < n; ++k) renumber(rec_[k].coll.code);
     queue_.build(times);
     linkCells();
-    slotOf_.assign(w_.particles.size(), kNil);
+    // The World-to-slot table serves the hybrid's questions about single particles; a run with holdState asks none.
+    if (s_.holdState)
+        std::vector<std::uint32_t>().swap(slotOf_);
+    else
+        slotOf_.assign(w_.particles.size(), kNil);
     free_.clear();
     for (std::uint32_t k = static_cast<std::uint32_t>(n); k-- > 0;) {
         if (rec_[k].idx == kNil)
             free_.push_back(k);
-        else
+        else if (!slotOf_.empty())
             slotOf_[rec_[k].idx] = k;
     }
     sortedAt_ = events_;
@@ -469,8 +493,9 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
         return;
     }
     const Domain<D>& dom = w_.domain;
+    queue_.prefetchPath(s);
     const Hot& hs = hot_[s];
-    const Shift ws = link_[s].wrap;
+    const Shift ws = wrapsOf(link_[s].wrap);
     // Cell coordinates, the faces s can leave through, and the neighbour cells per axis. The exit is computed from
     // the state at "now": from the older stored state the quadratic can also find a crossing that already
     // happened (through a face and back under gravity).
@@ -511,7 +536,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
     }
     Candidate best;
     if (axis >= 0) {
-        best = rec_[s].coll;
+        best = {keptTime(s, now), rec_[s].coll.code, rec_[s].coll.stamp};
     } else {
         for (std::size_t w = 0; w < w_.walls.size(); ++w) {
             const double t = wallTime(s, w, now);
@@ -558,6 +583,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
         __builtin_prefetch(&hot_[heads[q]]);
         __builtin_prefetch(&link_[heads[q]]);
     }
+    queue_.prefetchRivals(s);
     // The canonical form of pairTime, written out for speed: the older of the two states is extrapolated to the
     // other's clock (an extrapolation by zero leaves a state unchanged, so skipping it gives the same bits).
     // Candidates later than the best pair or wall event so far are skipped before the square root, but never
@@ -573,10 +599,11 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
             const std::uint32_t nextJ = lj.next;
             if (j != s) {
                 const Hot& hj = hot_[j];
+                const Shift wj = wrapsOf(lj.wrap);
                 double t = kNever;
                 if (hj.t == kNever) {
                     Shift m;
-                    for (int k = 0; k < D; ++k) m[k] = base[k] + lj.wrap[k];
+                    for (int k = 0; k < D; ++k) m[k] = base[k] + wj[k];
                     t = pairTime(s, j, m, now, best.time);
                 } else {
                     double r[D], v[D], tr;
@@ -585,7 +612,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
                         const double db = ts - hj.t;
                         for (int k = 0; k < D; ++k) {
                             const double xb = hj.x[k] + (hj.v[k] + gHalf[k] * db) * db;
-                            r[k] = (hs.x[k] - xb) + (base[k] + lj.wrap[k]) * boxLen_[k];
+                            r[k] = (hs.x[k] - xb) + (base[k] + wj[k]) * boxLen_[k];
                             v[k] = hs.v[k] - (hj.v[k] + g_[k] * db);
                         }
                     } else {
@@ -593,7 +620,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
                         const double da = hj.t - ts;
                         for (int k = 0; k < D; ++k) {
                             const double xa = hs.x[k] + (hs.v[k] + gHalf[k] * da) * da;
-                            r[k] = (xa - hj.x[k]) + (base[k] + lj.wrap[k]) * boxLen_[k];
+                            r[k] = (xa - hj.x[k]) + (base[k] + wj[k]) * boxLen_[k];
                             v[k] = (hs.v[k] + g_[k] * da) - hj.v[k];
                         }
                     }
@@ -612,7 +639,7 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
                             t = tr + firstRootFalling(c, 2 * b, 2 * v2);
                             if (t < now) {
                                 Shift m;
-                                for (int k = 0; k < D; ++k) m[k] = base[k] + lj.wrap[k];
+                                for (int k = 0; k < D; ++k) m[k] = base[k] + wj[k];
                                 t = pairTimeFromNow(s, j, m, now);
                             }
                         }
@@ -624,10 +651,54 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
             j = nextJ;
         }
     }
-    rec_[s].coll = best;
-    const Candidate& next = cross.better(best.time, best.code) ? best : cross;
-    rec_[s].evCode = next.code;
-    queue_.update(s, next.time);
+    setPending(s, best, cross);
+}
+
+template <int D>
+void EdmEngine<D>::setPending(std::uint32_t s, const Candidate& best, const Candidate& cross) {
+    Rec& r = rec_[s];
+    r.coll = Kept{best.code, best.stamp};
+    r.exit = cross.code & 7u;
+    const bool crossing = !cross.better(best.time, best.code);  // a tie goes to the pair or wall event
+    r.crossing = crossing;
+    queue_.update(s, crossing ? cross.time : best.time);
+}
+
+// Whether the best pair or wall event of slot s's last scan is still its best among the cells scanned then, so that a
+// crossing needs to scan only the new neighbour cells: its partner has not collided since (walls and frozen partners
+// never change), and its time can be recomputed (keptTime). Not for a frozen partner: under gravity its path relative
+// to s is a parabola, which can carry s far away and back, beyond the reach of the minimum image.
+template <int D>
+bool EdmEngine<D>::keepsColl(std::uint32_t s) const {
+    if (!partialScans_) return false;
+    const Kept& c = rec_[s].coll;
+    if ((c.code >> kTypeShift) != kPair) return true;
+    const std::uint32_t j = c.code & kIndexMask;
+    return link_[j].count == c.stamp && !frozen(j);
+}
+
+// The time of slot s's kept event, recomputed at a crossing (now) in the canonical form, so the same bits as when the
+// scan found it, unless a synchronisation has rounded the stored states since or the state is invalid (PHYSICS.md
+// D.6: decided afresh from the state now); docs/edm.md, "Canonical arithmetic". The partner's periodic
+// image is the minimum image now: the pair approaches, so the two are no farther apart than when the scan found them
+// in neighbouring cells (sqrt(D) times two cell edges), which is less than half the box with 7 cells per axis.
+template <int D>
+double EdmEngine<D>::keptTime(std::uint32_t s, double now) const {
+    const Kept& c = rec_[s].coll;
+    const std::uint32_t k = c.code & kIndexMask;
+    switch (c.code >> kTypeShift) {
+        case kWall:
+            return wallTime(s, k, now);
+        case kPair: {
+            const Vec<D> d = posAt(hot_[s], now) - posAt(hot_[k], now);
+            Shift m{};
+            for (int a = 0; a < D; ++a)
+                if (w_.domain.periodic[a]) m[a] = -static_cast<std::int32_t>(std::nearbyint(d[a] / boxLen_[a]));
+            return pairTime(s, k, m, now, kNever);
+        }
+        default:
+            return kNever;
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -717,7 +788,7 @@ template <int D>
 void EdmEngine<D>::moveShell(std::uint32_t s, double now) {
     unlinkShell(s);
     const Vec<D> x = posAt(hot_[s], now);
-    Shift& ws = link_[s].wrap;
+    Shift ws = wrapsOf(link_[s].wrap);
     Vec<D> c;
     for (int k = 0; k < D; ++k) {
         c[k] = x[k] - ws[k] * boxLen_[k];
@@ -726,6 +797,7 @@ void EdmEngine<D>::moveShell(std::uint32_t s, double now) {
         ws[k] += static_cast<std::int32_t>(std::floor((c[k] - lo) / L));
         c[k] = x[k] - ws[k] * boxLen_[k];
     }
+    setWraps(s, ws);
     centre_[s].c = c;
     const std::uint32_t cell = cellOf(c);
     if (cell != rec_[s].cell) {
@@ -777,7 +849,7 @@ void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
         __builtin_prefetch(&hot_[a[q] & kSlotMask]);
         if (periodic_) __builtin_prefetch(&link_[a[q] & kSlotMask]);
     }
-    const Shift ws = link_[s].wrap;
+    const Shift ws = wrapsOf(link_[s].wrap);
     const Vec<D> xNow = posAt(hs, now), vNow = velAt(hs, now);
     const Vec<D>& c = centre_[s].c;
     Candidate cross;
@@ -800,7 +872,7 @@ void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
         Shift m{};
         if (periodic_) {
             const std::uint32_t image = a[q] >> kImageShift;
-            const Shift& wj = link_[j].wrap;
+            const Shift wj = wrapsOf(link_[j].wrap);
             for (int k = 0; k < D; ++k) m[k] = wj[k] - ws[k] - (static_cast<std::int32_t>((image >> (2 * k)) & 3u) - 1);
         }
         const double t = candidateTime(hs, s, j, m, now, best.time);
@@ -811,22 +883,18 @@ void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
         }
     }
     if (bestJ != kNil) best.stamp = link_[bestJ].count;
-    rec_[s].coll = best;
-    const Candidate& next = cross.better(best.time, best.code) ? best : cross;
-    rec_[s].evCode = next.code;
-    queue_.update(s, next.time);
+    setPending(s, best, cross);
 }
 
 template <int D>
 void EdmEngine<D>::crossCell(std::uint32_t s, int axis, bool up) {
     const int c = static_cast<int>((rec_[s].cell / stride_[axis]) % static_cast<std::uint32_t>(nCell_[axis]));
     int cn = c + (up ? 1 : -1);
-    if (cn >= nCell_[axis]) {  // only on periodic axes: outer cells of open axes are unbounded
-        cn = 0;
-        link_[s].wrap[axis] += 1;
-    } else if (cn < 0) {
-        cn = nCell_[axis] - 1;
-        link_[s].wrap[axis] -= 1;
+    if (cn >= nCell_[axis] || cn < 0) {  // only on periodic axes: outer cells of open axes are unbounded
+        cn = cn < 0 ? nCell_[axis] - 1 : 0;
+        Shift ws = wrapsOf(link_[s].wrap);
+        ws[axis] += up ? 1 : -1;
+        setWraps(s, ws);
     }
     const std::uint32_t newCell =
         rec_[s].cell + (static_cast<std::uint32_t>(cn) - static_cast<std::uint32_t>(c)) * stride_[axis];
@@ -869,8 +937,8 @@ CollisionLaw EdmEngine<D>::lawFor(int matA, int matB, bool elastic) const {
 template <int D>
 bool EdmEngine<D>::tcElastic(std::uint32_t a, std::uint32_t b, double t) const {
     if (!(tc_ > 0)) return false;
-    if (t - rec_[a].tLast < tc_) return true;
-    return b != kNil && t - rec_[b].tLast < tc_;
+    if (t - tLast_[a] < tc_) return true;
+    return b != kNil && t - tLast_[b] < tc_;
 }
 
 template <int D>
@@ -932,12 +1000,12 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     hot_[a].v = b1.v;
     p.w[i] = b1.w;
     ++link_[a].count;
-    rec_[a].tLast = t;
+    if (tc_ > 0) tLast_[a] = t;
     if (!fb) {
         hot_[b].v = b2.v;
         p.w[j] = b2.w;
         ++link_[b].count;
-        rec_[b].tLast = t;
+        if (tc_ > 0) tLast_[b] = t;
     }
     virial_ += dot(d, P);
     ++stats_.pairCollisions;
@@ -973,7 +1041,7 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     hot_[s].v = b1.v;
     p.w[i] = b1.w;
     ++link_[s].count;
-    rec_[s].tLast = t;
+    if (tc_ > 0) tLast_[s] = t;
     ++stats_.wallCollisions;
     if (elastic) ++stats_.tcElastic;
     if (hop) ++stats_.restHops;
@@ -1008,7 +1076,8 @@ void EdmEngine<D>::processNext() {
     const std::uint32_t s = queue_.top();
     const double t = queue_.topTime();
     countEvent(t);
-    const std::uint32_t code = rec_[s].evCode;
+    const Rec& rs = rec_[s];
+    const std::uint32_t code = rs.crossing ? (kCell << kTypeShift) | rs.exit : rs.coll.code;
     const std::uint32_t k = code & kIndexMask;
     switch (code >> kTypeShift) {
         case kPair:
@@ -1037,9 +1106,7 @@ void EdmEngine<D>::processNext() {
             const bool up = k & 1;
             crossCell(s, axis, up);
             // The earlier scan's best pair or wall event stays valid unless its partner collided since.
-            const Candidate& c = rec_[s].coll;
-            const bool valid = (c.code >> kTypeShift) != kPair || link_[c.code & kIndexMask].count == c.stamp;
-            if (valid)
+            if (keepsColl(s))
                 predict(s, t, axis, up ? 1 : -1);
             else
                 predict(s, t);
@@ -1053,11 +1120,27 @@ void EdmEngine<D>::processNext() {
 
 template <int D>
 void EdmEngine<D>::syncSlot(std::uint32_t s, double t) {
+    advance(s, t);
+    storeSlot(s);
+    const Particles<D>& p = w_.particles;
+    const Hot& h = hot_[s];
+    const std::uint32_t i = rec_[s].idx;
+    if (!std::isfinite(norm2(h.x) + norm2(h.v) + norm2(p.w[i]))) {
+        std::ostringstream msg;
+        msg << "event-driven engine: particle " << p.id[i] << " (index " << i << ") has a non-finite state at t = " << t
+            << " s";
+        throw SimulationError(msg.str());
+    }
+}
+
+// Writes moving slot s's stored state (at its clock) to the World, its position wrapped into the box.
+template <int D>
+void EdmEngine<D>::storeSlot(std::uint32_t s) {
     Particles<D>& p = w_.particles;
     const Domain<D>& dom = w_.domain;
-    advance(s, t);
     Hot& h = hot_[s];
     const std::uint32_t i = rec_[s].idx;
+    Shift ws = wrapsOf(link_[s].wrap);
     for (int k = 0; k < D; ++k) {
         if (!dom.periodic[k]) continue;
         double& x = h.x[k];
@@ -1067,23 +1150,49 @@ void EdmEngine<D>::syncSlot(std::uint32_t s, double t) {
         x -= sh * L;
         p.image[i][k] += sh * L;
         // The box-frame position x - wrap L is unchanged, so the cell and the pending events stay valid.
-        link_[s].wrap[k] -= static_cast<std::int32_t>(sh);
+        ws[k] -= static_cast<std::int32_t>(sh);
     }
+    link_[s].wrap = packWraps(ws);
     p.x[i] = h.x;
     p.v[i] = h.v;
-    if (!std::isfinite(norm2(h.x) + norm2(h.v) + norm2(p.w[i]))) {
-        std::ostringstream msg;
-        msg << "event-driven engine: particle " << p.id[i] << " (index " << i << ") has a non-finite state at t = " << t
-            << " s";
-        throw SimulationError(msg.str());
-    }
 }
 
 template <int D>
 void EdmEngine<D>::synchronise(double t) {
-    for (std::uint32_t s = 0; s < hot_.size(); ++s)
-        if (!frozen(s)) syncSlot(s, t);
+    Particles<D>& p = w_.particles;
+    const bool restore = !p.hasMotion();
+    if (restore) p.restoreMotion();
+    for (std::uint32_t s = 0; s < hot_.size(); ++s) {
+        const std::uint32_t i = rec_[s].idx;
+        if (i == kNil) continue;
+        if (!frozen(s)) {
+            syncSlot(s, t);
+        } else if (restore) {
+            p.x[i] = hot_[s].x;
+            p.v[i] = hot_[s].v;
+        }
+        if (restore) p.radius[i] = hot_[s].r;
+    }
     w_.time = t;
+}
+
+// After an error in advanceEvents: the World gets its arrays back with every particle's state at its own clock.
+template <int D>
+void EdmEngine<D>::putBackState() {
+    Particles<D>& p = w_.particles;
+    if (p.hasMotion()) return;
+    p.restoreMotion();
+    for (std::uint32_t s = 0; s < hot_.size(); ++s) {
+        const std::uint32_t i = rec_[s].idx;
+        if (i == kNil) continue;
+        if (!frozen(s)) {
+            storeSlot(s);
+        } else {
+            p.x[i] = hot_[s].x;
+            p.v[i] = hot_[s].v;
+        }
+        p.radius[i] = hot_[s].r;
+    }
 }
 
 template <int D>
@@ -1163,7 +1272,13 @@ void EdmEngine<D>::advanceTo(double t) {
 template <int D>
 void EdmEngine<D>::advanceEvents(double t) {
     if (s_.reference) throw std::logic_error("event-driven engine: advanceEvents in reference mode");
-    while (queue_.size() > 0 && queue_.topTime() < t) processNext();
+    if (s_.holdState && w_.particles.hasMotion()) w_.particles.releaseMotion();
+    try {
+        while (queue_.size() > 0 && queue_.topTime() < t) processNext();
+    } catch (...) {
+        putBackState();
+        throw;
+    }
     // Particles diffuse away from their sorted neighbours; re-sort after ~20 events per particle.
     if (events_ - sortedAt_ > 20 * static_cast<std::uint64_t>(std::max<std::size_t>(nLive_, 1))) resort();
 }
@@ -1173,6 +1288,7 @@ void EdmEngine<D>::advanceEvents(double t) {
 
 template <int D>
 void EdmEngine<D>::remove(std::size_t i, double t) {
+    if (s_.holdState) throw std::logic_error("event-driven engine: particles join and leave only without holdState");
     if (!owns(i)) throw std::logic_error("event-driven engine: remove of a particle it does not own");
     const std::uint32_t s = slotOf_[i];
     const bool fz = frozen(s);
@@ -1185,8 +1301,8 @@ void EdmEngine<D>::remove(std::size_t i, double t) {
     hot_[s].v = Vec<D>::zero();
     rec_[s].idx = kNil;
     rec_[s].cell = static_cast<std::uint32_t>(head_.size());
-    rec_[s].evCode = kNone << kTypeShift;
-    rec_[s].coll = Candidate{};
+    rec_[s].coll = Kept{};
+    rec_[s].crossing = 0;
     queue_.update(s, kNever);
     slotOf_[i] = kNil;
     free_.push_back(s);
@@ -1197,6 +1313,7 @@ void EdmEngine<D>::remove(std::size_t i, double t) {
 template <int D>
 void EdmEngine<D>::add(std::size_t i, double t) {
     Particles<D>& p = w_.particles;
+    if (s_.holdState) throw std::logic_error("event-driven engine: particles join and leave only without holdState");
     if (owns(i) || i >= p.size()) throw std::logic_error("event-driven engine: add of an owned or unknown particle");
     if (free_.empty()) throw std::logic_error("event-driven engine: no free slot");
     if (p.radius[i] > rmax_ * (1 + 1e-12)) throw std::logic_error("event-driven engine: particle larger than the grid");
@@ -1205,10 +1322,10 @@ void EdmEngine<D>::add(std::size_t i, double t) {
     wrapIntoBox(i);
     const bool fz = p.frozen(i);
     hot_[s] = Hot{p.x[i], fz ? kNever : t, fz ? Vec<D>::zero() : p.v[i], p.radius[i]};
-    link_[s].wrap = Shift{};
+    link_[s].wrap = packWraps(Shift{});
     ++link_[s].count;
-    rec_[s].coll = Candidate{};
-    rec_[s].tLast = -std::numeric_limits<double>::infinity();
+    rec_[s].coll = Kept{};
+    if (tc_ > 0) tLast_[s] = -std::numeric_limits<double>::infinity();
     rec_[s].idx = static_cast<std::uint32_t>(i);
     insertCell(s, cellOf(p.x[i]));
     if (zoned_) zoneVolume_[zoneOfCell(rec_[s].cell)] += Particles<D>::volumeOf(hot_[s].r);
@@ -1250,6 +1367,7 @@ void EdmEngine<D>::add(std::size_t i, double t) {
 template <int D>
 void EdmEngine<D>::swapIndices(std::size_t i, std::size_t j) {
     if (i == j) return;
+    if (s_.holdState) throw std::logic_error("event-driven engine: swapIndices needs holdState off");
     std::swap(slotOf_[i], slotOf_[j]);
     if (slotOf_[i] != kNil) rec_[slotOf_[i]].idx = static_cast<std::uint32_t>(i);
     if (slotOf_[j] != kNil) rec_[slotOf_[j]].idx = static_cast<std::uint32_t>(j);
@@ -1300,7 +1418,7 @@ Vec<D> EdmEngine<D>::positionAt(std::size_t i, double t) const {
     Vec<D> x = posAt(hot_[s], t);
     for (int k = 0; k < D; ++k) {
         if (!w_.domain.periodic[k]) continue;
-        x[k] -= link_[s].wrap[k] * boxLen_[k];
+        x[k] -= wrapsOf(link_[s].wrap)[k] * boxLen_[k];
         const double lo = w_.domain.lo[k], L = boxLen_[k];
         x[k] -= std::floor((x[k] - lo) / L) * L;
     }
@@ -1322,7 +1440,7 @@ double EdmEngine<D>::nextEventTime() const {
 template <int D>
 std::size_t EdmEngine<D>::memoryBytes() const {
     auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-    return bytes(hot_) + bytes(link_) + bytes(rec_) + queue_.memoryBytes() + bytes(head_) + bytes(slotOf_) +
+    return bytes(hot_) + bytes(link_) + bytes(rec_) + bytes(tLast_) + queue_.memoryBytes() + bytes(head_) + bytes(slotOf_) +
            bytes(free_) + bytes(zoneVolume_) + bytes(centre_) + bytes(nbr_);
 }
 

@@ -40,6 +40,12 @@ struct EdmSettings {
     /// loop). 0: 1000 / tcTime (also when the TC model is off); without any TC time 10^4 u / d_min, where u is
     /// the largest of the rms particle speed, sqrt(|g| d_min) and the fastest wall speed at the start.
     double maxEventRate = 0;
+    /// A pure event-driven run (no other engine on the store, firstParticle = 0): between synchronisations the
+    /// engine holds the only copy of positions, velocities and radii. advanceEvents releases the World's
+    /// (Particles::releaseMotion) and synchronise writes them back; reset() needs them back first. The engine then
+    /// keeps no World-to-slot table: the questions about single particles (owns, add, remove, swapIndices,
+    /// positionAt, velocityAt, collisionCount, cellOfParticle) are the hybrid's, and unavailable.
+    bool holdState = false;
     /// World index of the first particle this engine owns. Those before it belong to another engine (the
     /// time-driven one of a hybrid run) and are invisible here; particles join and leave with add() and remove().
     std::size_t firstParticle = 0;
@@ -104,9 +110,11 @@ public:
     void advanceTo(double t);
 
     /// Processes all events before t without bringing the particles to t (their clocks stay where their last
-    /// event left them); the World's copy of this engine's particles is stale until synchronise().
+    /// event left them); the World's copy of this engine's particles is stale (with EdmSettings::holdState: absent)
+    /// until synchronise(). If it throws, a held state is put back as it is, each particle at its own clock.
     void advanceEvents(double t);
     /// Brings every particle of this engine to time t and writes its state to the World; world.time = t.
+    /// With EdmSettings::holdState it also gives the World back its positions, velocities and radii.
     void synchronise(double t);
 
     // ---- particles joining and leaving (hybrid runs) ----
@@ -233,8 +241,24 @@ private:
     struct Link {
         std::uint32_t next;   // next slot in the same cell
         std::uint32_t count;  // collision counter (stale-event test)
-        Shift wrap;           // box-frame position = x - wrap * L on periodic axes
+        std::uint32_t wrap;   // box-frame position = x - wrap * L on periodic axes; packed, wrapsOf
     };
+    // Periodic wraps since the last synchronisation, kWrapBits per axis with a bias. One that would leave the
+    // field moves the whole box lengths from the stored position into Particles::image, as a synchronisation does.
+    static constexpr int kWrapBits = D == 3 ? 10 : 16;
+    static constexpr std::int32_t kWrapBias = 1 << (kWrapBits - 1), kWrapLimit = kWrapBias - 2;
+    static Shift wrapsOf(std::uint32_t packed) {
+        Shift w;
+        for (int k = 0; k < D; ++k)
+            w[k] = static_cast<std::int32_t>((packed >> (kWrapBits * k)) & ((1u << kWrapBits) - 1)) - kWrapBias;
+        return w;
+    }
+    static std::uint32_t packWraps(const Shift& w) {
+        std::uint32_t packed = 0;
+        for (int k = 0; k < D; ++k) packed |= static_cast<std::uint32_t>(w[k] + kWrapBias) << (kWrapBits * k);
+        return packed;
+    }
+    void setWraps(std::uint32_t s, Shift w);
     struct Candidate {
         double time = kNever;
         std::uint32_t code = kNone << kTypeShift;
@@ -252,6 +276,9 @@ private:
     void removeCell(std::uint32_t s);
     void resort();
     void predict(std::uint32_t s, double now, int axis = -1, int dir = 0);
+    void setPending(std::uint32_t s, const Candidate& best, const Candidate& cross);
+    bool keepsColl(std::uint32_t s) const;
+    double keptTime(std::uint32_t s, double now) const;
     void predictShell(std::uint32_t s, double now);
     double candidateTime(const Hot& hs, std::uint32_t s, std::uint32_t j, const Shift& m, double now,
                          double bestTime) const;
@@ -272,6 +299,8 @@ private:
     void crossCell(std::uint32_t s, int axis, bool up);
     void advance(std::uint32_t s, double t);
     void syncSlot(std::uint32_t s, double t);
+    void storeSlot(std::uint32_t s);
+    void putBackState();
     std::uint32_t zoneOfCell(std::uint32_t c) const;
     void countEvent(double t);
     Vec<D> posAt(const Hot& h, double t) const;
@@ -294,24 +323,31 @@ private:
     // per slot
     std::vector<Hot> hot_;
     std::vector<Link> link_;
-    // What an event of the slot itself needs, in one cache line
+    // What an event of the slot itself needs (16 bytes). The pending event's time is the queue's; the time of
+    // coll is not kept: while the crossing is pending it is recomputed when needed (keptTime).
+    static constexpr std::uint32_t kCellBits = 28;
+    struct Kept {
+        std::uint32_t code = kNone << kTypeShift;
+        std::uint32_t stamp = 0;
+    };
     struct Rec {
-        Candidate coll;        // earliest pair or wall event found by the last scan (code, partner's counter)
-        double tLast;          // time of the last collision (TC model)
-        std::uint32_t evCode;  // pending event: coll's code or a cell crossing (2 axis + up)
-        std::uint32_t cell;    // cell index
-        std::uint32_t prev;    // previous slot in the cell's list
-        std::uint32_t idx;     // slot -> World index
+        Kept coll;  // earliest pair or wall event found by the last scan: code, partner's counter
+        std::uint32_t cell : kCellBits;  // cell index (free slot: head_.size())
+        std::uint32_t exit : 3;          // face of the cell crossing (shell exit) found by the last scan: 2 axis + up
+        std::uint32_t crossing : 1;      // the pending event is that crossing, not coll
+        std::uint32_t idx;               // slot -> World index
     };
     std::vector<Rec> rec_;
+    std::vector<double> tLast_;  // per slot: time of the last collision (only with the TC model)
     EventTree queue_;  // pending event times
-    // cell grid (linked lists with O(1) move)
+    // cell grid (singly linked lists: a crossing walks the old cell's few members to unlink)
     std::vector<std::uint32_t> head_;
     std::vector<std::int32_t> deltaFull_;                     // neighbour cell offsets (cells away from the faces)
     std::array<std::vector<std::int32_t>, 2 * D> deltaSide_;  // new neighbours after a crossing
     std::array<int, D> nCell_{};
     std::array<std::uint32_t, D> stride_{};
     Vec<D> cellW_;
+    bool partialScans_ = true;  // crossings scan only the new neighbour cells (docs/edm.md: needs 7 cells per periodic axis)
 
     // Neighbour shells (shells_): per slot the box-frame centre of its cube (edge 2 shellHalf_) and a row of rowLen_
     // words in nbr_: the count, then the neighbours, each a slot with the periodic image of the neighbour's centre

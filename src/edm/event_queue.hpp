@@ -4,7 +4,8 @@
 //
 //  * EventTree: complete binary (tournament) tree, Marin, Risso & Cordero, J. Comput. Phys. 109, 306 (1993).
 //    Internal node k holds the winner (the slot of smallest time) of its two children; changing one slot replays
-//    the path to the root and stops early once a node's winner is unchanged and is not the changed slot.
+//    the path to the root and stops early once a node's winner is unchanged and is not the changed slot. N leaves
+//    and N - 1 nodes, 12 bytes per slot (a tree padded to a power of two took up to twice that).
 //    (A variant holding the winner's time in the node, one cache line per level, measured no faster in the
 //    engine and takes twice the memory.)
 //  * EventHeap: binary heap of slots with handles (position of each slot in the heap), decrease/increase-key.
@@ -23,31 +24,27 @@ public:
     /// n slots, every time +infinity.
     void reset(std::size_t n) {
         n_ = n;
-        m_ = 2;
-        while (m_ < n) m_ *= 2;
-        time_.assign(m_, std::numeric_limits<double>::infinity());
-        node_.assign(m_, 0);
-        // Winners of the all-infinite tree: the leftmost slot of each subtree.
-        for (std::size_t k = m_ - 1; k >= 1; --k) node_[k] = winner(2 * k);
+        leaves_ = std::max<std::size_t>(n, 2);
+        pow_ = 1;
+        while (pow_ < leaves_) pow_ *= 2;
+        time_.assign(leaves_, std::numeric_limits<double>::infinity());
+        node_.assign(leaves_, 0);
+        for (std::size_t k = leaves_ - 1; k >= 1; --k) node_[k] = play(k);
     }
     std::size_t size() const { return n_; }
     /// Sets all times at once (t.size() slots), O(N).
     void build(const std::vector<double>& t) {
         reset(t.size());
         std::copy(t.begin(), t.end(), time_.begin());
-        for (std::size_t k = m_ - 1; k >= 1; --k) {
-            const std::uint32_t a = winner(2 * k), b = winner(2 * k + 1);
-            node_[k] = time_[b] < time_[a] ? b : a;
-        }
+        for (std::size_t k = leaves_ - 1; k >= 1; --k) node_[k] = play(k);
     }
 
     void update(std::uint32_t i, double t) {
         time_[i] = t;
-        std::size_t k = (m_ + i) >> 1;
+        std::size_t k = leafOf(i) >> 1;
         while (k >= 1) {
-            const std::uint32_t a = winner(2 * k), b = winner(2 * k + 1);
-            const std::uint32_t w = time_[b] < time_[a] ? b : a;  // ties: the left (lower) slot
-            if (node_[k] == w && w != i) break;                   // the subtree's winner and its time are unchanged
+            const std::uint32_t w = play(k);
+            if (node_[k] == w && w != i) break;  // the subtree's winner and its time are unchanged
             node_[k] = w;
             k >>= 1;
         }
@@ -57,11 +54,35 @@ public:
     double time(std::uint32_t i) const { return time_[i]; }
     std::size_t memoryBytes() const { return time_.capacity() * sizeof(double) + node_.capacity() * 4; }
 
+    /// Cache hints for an update of slot i that is coming (the engine's prediction of slot i ends with it): first
+    /// the nodes on its path to the root, then, once those are in, the times of the winners beside the path. An
+    /// update of the slot that just won replays the whole path, one dependent pair of loads per level.
+    void prefetchPath(std::uint32_t i) const {
+        for (std::size_t k = leafOf(i) >> 1; k >= 1; k >>= 1) __builtin_prefetch(&node_[2 * k < leaves_ ? 2 * k : k]);
+        __builtin_prefetch(&time_[i]);
+    }
+    void prefetchRivals(std::uint32_t i) const {
+        for (std::size_t c = leafOf(i); c > 1; c >>= 1) __builtin_prefetch(&time_[winner(c ^ 1)]);
+    }
+
 private:
-    std::uint32_t winner(std::size_t k) const { return k >= m_ ? static_cast<std::uint32_t>(k - m_) : node_[k]; }
-    std::size_t n_ = 0, m_ = 2;
-    std::vector<double> time_;         // size m_ (padding slots stay infinite)
-    std::vector<std::uint32_t> node_;  // node_[1..m_-1]: winner slot of the subtree
+    // The tree has as many leaves as slots (at least two), node k has the children 2k and 2k + 1, and the leaves are
+    // the nodes leaves_ to 2 leaves_ - 1. Unless leaves_ is a power of two they lie on two levels, the deeper ones
+    // (from pow_ on) to the left of the others; the lower slots go to the deeper leaves, so that left is always the
+    // lower slot and a tie goes to the left child without comparing slots (a comparison of slots made the choice a
+    // branch, mispredicted half the time).
+    std::size_t leafOf(std::uint32_t i) const { return i < 2 * leaves_ - pow_ ? pow_ + i : i + pow_ - leaves_; }
+    std::uint32_t winner(std::size_t k) const {
+        if (k < leaves_) return node_[k];
+        return static_cast<std::uint32_t>(k >= pow_ ? k - pow_ : k + leaves_ - pow_);
+    }
+    std::uint32_t play(std::size_t k) const {
+        const std::uint32_t a = winner(2 * k), b = winner(2 * k + 1);
+        return time_[b] < time_[a] ? b : a;  // ties: the left (lower) slot
+    }
+    std::size_t n_ = 0, leaves_ = 2, pow_ = 2;
+    std::vector<double> time_;         // one per leaf (a padding leaf stays infinite)
+    std::vector<std::uint32_t> node_;  // node_[1..leaves_-1]: winner slot of the subtree
 };
 
 class EventHeap {

@@ -228,9 +228,12 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
             return std::make_unique<TdmDriver<D>>(world, ts, note);
         }
-        case Method::Edm:
+        case Method::Edm: {
             world.particles.dropTdmState();  // forces, torques and angles: nothing reads them in this run
-            return std::make_unique<EdmDriver<D>>(world, edmSettings(sc));
+            EdmSettings es = edmSettings(sc);
+            es.holdState = true;  // positions, velocities and radii only in the engine between synchronisations
+            return std::make_unique<EdmDriver<D>>(world, es);
+        }
         case Method::Haet: {
             std::string note;
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
