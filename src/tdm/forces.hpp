@@ -23,6 +23,7 @@
 
 #include "contact/laws.hpp"
 #include "contact/setup.hpp"
+#include "core/lanes.hpp"
 #include "core/particles.hpp"
 #include "core/wide3.hpp"
 #include "geometry/domain.hpp"
@@ -47,7 +48,8 @@ struct RangeTally {
     std::size_t nonFinite = ForceStats::kNone;
 };
 
-/// A cross pair evaluated before the ranges run (threaded path).
+/// What one pair adds to its owner (its partner gets -f and n x F_t): a cross pair evaluated before the ranges
+/// run (threaded path), or an entry of a PairBlock.
 template <int D>
 struct CrossPair {
     Vec<D> f;         ///< force on i [N]
@@ -57,9 +59,42 @@ struct CrossPair {
     bool touching;
 };
 
+/// One thread's buffers for a block of particles in forceRange: the block's touching pairs as a list (in pair
+/// order), their inputs gathered for the contact law, and what each adds to its owner, in pair order. A block
+/// holds at most kPairs listed pairs (more only when one particle alone has more), so its buffers stay in L1.
+template <int D>
+struct PairBlock {
+    static constexpr std::uint32_t kPairs = 128;   ///< listed pairs per block
+    static constexpr std::uint32_t kOwners = 64;   ///< particles per block
+    static constexpr std::uint32_t kNoPartner = 0xFFFFFFFFu;  ///< an entry taken from a cross pair's slot
+    /// Four doubles: a separation d then |d|^2, or a spring; the rows of four pairs are transposed into lanes.
+    struct alignas(32) Row {
+        double c[4];
+    };
+    // The touching pairs the law evaluates (list index m), padded to a multiple of 4.
+    std::vector<std::uint32_t> owner, partner, slot, coeff, entry;
+    std::vector<Row> sep, spring;
+    // The entries of the block's owners, in pair order: evaluated pairs and (threaded) cross pairs.
+    std::vector<CrossPair<D>> out;
+    std::vector<std::uint32_t> outPartner;  ///< j of each entry, kNoPartner for a cross pair
+    std::vector<std::uint32_t> ownerEnd;    ///< the block's particle b0 + q has entries [ownerEnd[q-1], ownerEnd[q])
+
+    /// Room for a block of `pairs` listed pairs.
+    void fit(std::size_t pairs) {
+        const std::size_t need = std::max<std::size_t>(pairs, kPairs) + 4;
+        if (owner.size() >= need) return;
+        for (auto* v : {&owner, &partner, &slot, &coeff, &entry, &outPartner}) v->resize(need);
+        sep.resize(need);
+        spring.resize(need);
+        out.resize(need);
+        ownerEnd.resize(kOwners + 1);
+    }
+};
+
 /// Buffers of the threaded paths, kept between steps so that no step allocates (one thread needs none).
 template <int D>
 struct ForceScratch {
+    std::vector<PairBlock<D>> blocks;  ///< one per thread (forceRange)
     std::vector<CrossPair<D>> cross;  ///< the disk loop's cross pairs (PairList::split)
     std::vector<Vec<D>> pairForce;    ///< polygon loop: force on i of each pair [N]
     std::vector<double> maxOverlap;   ///< polygon loop, per particle: largest overlap / smaller radius
@@ -111,6 +146,41 @@ struct Owner {
           coeffRow(in.table + in.material[i] * in.nMaterials) {}
 };
 
+/// The contact law of a touching pair, from the pair's separation d = x_i - x_j (+ shift), |d|^2, radii, inverse
+/// masses and velocities: F on i, n x F_t and the spring xi (updated), r . F and overlap / smaller radius.
+/// Written once for one pair (S = double) and for four in lanes (S = Lanes; core/lanes.hpp): the same operations
+/// in the same order, so a pair gets the same bits either way.
+template <class Normal, class Tangential, class C, class S, class V, class A>
+[[gnu::always_inline]] inline void contactLaw(const C& c, const V& d, S dist2, S ri, S rj, S invMi, S invMj,
+                                              const V& vi, const V& vj, const A& wi, const A& wj, const V& svi,
+                                              const V& svj, const A& swi, const A& swj, V& xi, bool clip,
+                                              double dt, V& f, A& nxft, S& virial, S& overlap) {
+    const S rsum = ri + rj;
+    const S dist = sqrtOf(dist2);
+    const V nrm = d * (1.0 / dist);
+    const S delta = rsum - dist;
+    // A frozen particle has 1/m = 0: it acts as infinitely heavy. (Frozen-frozen pairs are never listed.)
+    const S meff = 1.0 / (invMi + invMj);
+    const S reff = ri * rj / rsum;
+    const V dv = vi - vj;
+    const S gn = dot(dv, nrm);
+    NormalResultOf<S> nr = Normal::eval(c, delta, -gn, meff, reff);
+    if (clip) nr.fn = select(nr.fn < 0, S(0.0), nr.fn);
+    f = nrm * nr.fn;
+    if constexpr (Tangential::kHasHistory) {
+        // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
+        const V gt = dv - nrm * gn - cross(wi * ri + wj * rj, nrm);
+        const V gs = svi - svj - cross(swi * ri + swj * rj, nrm);
+        const V ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, xi, dt);
+        f += ft;
+        nxft = cross(nrm, ft);
+    } else {
+        nxft = A::zero();
+    }
+    virial = dot(d, f);
+    overlap = delta / minOf(ri, rj);
+}
+
 /// Evaluates pair slot k of owner a. Returns false when the pair is not touching (its spring is cleared).
 template <int D, class Normal, class Tangential>
 [[gnu::always_inline]] inline bool evalPair(const PairInputs<D>& in, const Owner<D>& a, std::uint32_t k,
@@ -128,32 +198,15 @@ template <int D, class Normal, class Tangential>
         if constexpr (Tangential::kHasHistory) in.history[k] = Vec<D>::zero();
         return false;
     }
-    const double dist = std::sqrt(dist2);
-    const V nrm = d * (1.0 / dist);
-    const double delta = rsum - dist;
-    // A frozen particle has 1/m = 0: it acts as infinitely heavy. (Frozen-frozen pairs are never listed.)
-    const double meff = 1.0 / (a.invMass + in.invMass[j]);
-    const double reff = ri * rj / rsum;
-    const V dv = a.v - kernelVec(in.v[j]);
-    const double gn = dot(dv, nrm);
-    const PairCoeffs& c = a.coeffRow[in.material[j]];
-    NormalResult nr = Normal::eval(c, delta, -gn, meff, reff);
-    if (in.clip && nr.fn < 0) nr.fn = 0;
-    out.f = nrm * nr.fn;
-    if constexpr (Tangential::kHasHistory) {
-        // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
-        const V gt = dv - nrm * gn - cross(a.w * ri + kernelVec(in.w[j]) * rj, nrm);
-        const V gs = a.sv - kernelVec(in.sv[j]) - cross(a.sw * ri + kernelVec(in.sw[j]) * rj, nrm);
-        V xi = kernelVec(in.history[k]);
-        const V ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, xi, in.dt);
-        in.history[k] = storedVec(xi);
-        out.f += ft;
-        out.nxft = cross(nrm, ft);
-    } else {
-        out.nxft = KernelVec<kAngDim<D>>::zero();
-    }
-    virial += dot(d, out.f);
-    overlapRatio = std::max(overlapRatio, delta / std::min(ri, rj));
+    V xi = V::zero();
+    if constexpr (Tangential::kHasHistory) xi = kernelVec(in.history[k]);
+    double vir, overlap;
+    contactLaw<Normal, Tangential>(a.coeffRow[in.material[j]], d, dist2, ri, rj, a.invMass, in.invMass[j], a.v,
+                                   kernelVec(in.v[j]), a.w, kernelVec(in.w[j]), a.sv, kernelVec(in.sv[j]), a.sw,
+                                   kernelVec(in.sw[j]), xi, in.clip, in.dt, out.f, out.nxft, vir, overlap);
+    if constexpr (Tangential::kHasHistory) in.history[k] = storedVec(xi);
+    virial += vir;
+    overlapRatio = std::max(overlapRatio, overlap);
     return true;
 }
 
@@ -212,18 +265,120 @@ template <int D, class Normal, class Tangential, class Then>
     return {worst, contacts, std::isfinite(s)};
 }
 
+/// Whether the contact law runs on four touching pairs at once (core/lanes.hpp): with AVX2, whose gathers load
+/// the four pairs' data. Otherwise the pairs of a block are evaluated one by one. Same bits either way.
+#ifdef __AVX2__
+inline constexpr bool kLanePairs = true;
+#else
+inline constexpr bool kLanePairs = false;
+#endif
+
+/// Stores a vector then, in the fourth place, a number (the squared length or 0) in a row of PairBlock.
+template <int D>
+inline void storeRow(double* row, const KernelVec<D>& v, double last) {
+#ifdef __AVX__
+    if constexpr (D == 3) {
+        _mm256_store_pd(row, _mm256_blend_pd(v.l, _mm256_set1_pd(last), 8));
+        return;
+    }
+#endif
+    const Vec<D> a = storedVec(v);
+    for (int k = 0; k < D; ++k) row[k] = a[k];
+    row[D] = last;
+}
+
+/// The law on the block's touching pairs [0, nl) (nl a multiple of 4 when kLanes): their springs go back to the
+/// pair list, their contributions to the block's entries.
+template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
+[[gnu::always_inline]] inline void evalBlock(const PairInputs<D>& in, PairBlock<D>& bl, std::uint32_t nl) {
+    using Row = typename PairBlock<D>::Row;
+    constexpr int A = kAngDim<D>;
+    for (std::uint32_t m = 0; m < nl; m += kLanes ? 4 : 1) {
+        if constexpr (kLanes) {
+            const LaneIndex ii = loadIndex(&bl.owner[m]), jj = loadIndex(&bl.partner[m]);
+            Lanes t[4];
+            const Row* r = &bl.sep[m];
+            transpose4(r[0].c, r[1].c, r[2].c, r[3].c, t);
+            LaneVec<D> d;
+            for (int k = 0; k < D; ++k) d.c[k] = t[k];
+            const Lanes dist2 = t[D];
+            LaneVec<D> xi = LaneVec<D>::zero();
+            if constexpr (Tangential::kHasHistory) {
+                r = &bl.spring[m];
+                transpose4(r[0].c, r[1].c, r[2].c, r[3].c, t);
+                for (int k = 0; k < D; ++k) xi.c[k] = t[k];
+            }
+            const LanePairCoeffs c(in.table, loadIndex(&bl.coeff[m]));
+            LaneVec<D> f;
+            LaneVec<A> nxft;
+            Lanes vir, overlap;
+            contactLaw<Normal, Tangential>(c, d, dist2, gather(in.radius, ii), gather(in.radius, jj),
+                                           gather(in.invMass, ii), gather(in.invMass, jj), gather(in.v, ii),
+                                           gather(in.v, jj), gather(in.w, ii), gather(in.w, jj), gather(in.sv, ii),
+                                           gather(in.sv, jj), gather(in.sw, ii), gather(in.sw, jj), xi, in.clip,
+                                           in.dt, f, nxft, vir, overlap);
+            for (int l = 0; l < 4; ++l) {
+                if constexpr (Tangential::kHasHistory) in.history[bl.slot[m + l]] = xi.lane(l);
+                CrossPair<D>& o = bl.out[kCross ? bl.entry[m + l] : m + l];
+                o.f = f.lane(l);
+                o.nxft = nxft.lane(l);
+                o.virial = vir[l];
+                o.overlap = overlap[l];
+            }
+        } else {
+            using V = KernelVec<D>;
+            using VA = KernelVec<A>;
+            const std::uint32_t i = bl.owner[m], j = bl.partner[m];
+            const double* r = bl.sep[m].c;
+            Vec<D> d;
+            for (int k = 0; k < D; ++k) d[k] = r[k];
+            V xi = V::zero();
+            if constexpr (Tangential::kHasHistory) {
+                Vec<D> h;
+                for (int k = 0; k < D; ++k) h[k] = bl.spring[m].c[k];
+                xi = kernelVec(h);
+            }
+            V f;
+            VA nxft;
+            double vir, overlap;
+            contactLaw<Normal, Tangential>(in.table[bl.coeff[m]], kernelVec(d), r[D], in.radius[i], in.radius[j],
+                                           in.invMass[i], in.invMass[j], kernelVec(in.v[i]), kernelVec(in.v[j]),
+                                           kernelVec(in.w[i]), kernelVec(in.w[j]), kernelVec(in.sv[i]),
+                                           kernelVec(in.sv[j]), kernelVec(in.sw[i]), kernelVec(in.sw[j]), xi,
+                                           in.clip, in.dt, f, nxft, vir, overlap);
+            if constexpr (Tangential::kHasHistory) in.history[bl.slot[m]] = storedVec(xi);
+            CrossPair<D>& o = bl.out[kCross ? bl.entry[m] : m];
+            o.f = storedVec(f);
+            o.nxft = storedVec(nxft);
+            o.virial = vir;
+            o.overlap = overlap;
+        }
+    }
+}
+
 /// The pass over particles [b, e), which holds every partner of their pairs except the cross pairs (kCross:
 /// partner >= e), evaluated before into cross[c0...] in pair order; crossIn: the cross pairs whose partner is in
 /// [b, e), by partner then pair. Per-particle virial sums go to virial[i] when a thread split needs them kept
 /// apart, else into *virialSum (in particle order either way).
-template <int D, class Normal, class Tangential, bool kCross, class Then>
+///
+/// The particles go in blocks of a few dozen, each in three passes. (1) The contact test of every listed pair,
+/// without a branch: each pair is written at the end of the list of touching pairs, which grows by one when it
+/// touches; its spring moves from the pair list to the block (the pair list keeps a zero, which is right for a
+/// pair not touching). (2) The contact law on the touching pairs, four at a time in lanes (evalBlock): their long
+/// chains of square roots and divisions overlap instead of waiting one behind the other. (3) In pair order, as
+/// with one pair at a time, each contribution is added to its owner and subtracted from its partner, and each
+/// particle is finished. The law reads positions and velocities only, which no particle of the block or after it
+/// has had changed yet (finishing changes a particle's velocity, and comes after its last pair), so the three
+/// passes give the bits of evaluating each pair as its owner comes.
+template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class Then>
 [[gnu::always_inline]] inline RangeTally forceRange(Particles<D>& p, const PairInputs<D>& in,
                                                      const std::uint32_t* first, const Wall<D>* walls, std::size_t nw,
                                                      Vec<D>* wh, const ContactSetup& cs, double time, const Vec<D>& g,
                                                      std::size_t b, std::size_t e, const CrossPair<D>* cross,
                                                      std::size_t c0, const std::uint64_t* crossIn,
                                                      const std::uint64_t* crossInEnd, double* virial,
-                                                     double* virialSum, Then& then) {
+                                                     double* virialSum, PairBlock<D>& bl, Then& then) {
+    using Block = PairBlock<D>;
     Vec<D>* f = p.f.data();
     Ang<D>* nx = p.torque.data();  // holds the sums of n x F_t until the particle is finished
     const double* mass = p.mass.data();
@@ -248,48 +403,105 @@ template <int D, class Normal, class Tangential, bool kCross, class Then>
     };
     RangeTally st;
     std::size_t c = c0;
-    for (std::size_t i = b; i < e; ++i) {
-        const std::uint32_t k0 = first[i], k1 = first[i + 1];
-        std::size_t reach = k1 > k0 ? std::size_t{in.partner[k1 - 1]} + 1 : i + 1;
-        if constexpr (kCross) reach = std::min(reach, e);
-        startUpTo(std::max(reach, i + 1));
-        const Owner<D> a(in, i);
-        KernelVec<D> fi = kernelVec(f[i]);
-        KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
-        double worst = 0, vir = 0;
-        std::uint32_t nc = 0;
-        for (std::uint32_t k = k0; k < k1; ++k) {
-            const std::uint32_t j = in.partner[k];
-            if constexpr (kCross) {
-                if (j >= e) {
-                    const CrossPair<D>& x = cross[c++];
-                    if (!x.touching) continue;
-                    fi += kernelVec(x.f);
-                    nxi += kernelVec(x.nxft);
-                    vir += x.virial;
-                    worst = std::max(worst, x.overlap);
-                    ++nc;
-                    continue;
+    for (std::size_t b0 = b, b1; b0 < e; b0 = b1) {
+        b1 = b0 + 1;
+        while (b1 < e && b1 - b0 < Block::kOwners && first[b1 + 1] - first[b0] <= Block::kPairs) ++b1;
+        bl.fit(first[b1] - first[b0]);
+        // (1) The contact tests.
+        std::uint32_t nl = 0, ne = 0;
+        for (std::size_t i = b0; i < b1; ++i) {
+            const Owner<D> a(in, i);
+            const std::uint32_t row = static_cast<std::uint32_t>(a.coeffRow - in.table);
+            for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
+                const std::uint32_t j = in.partner[k];
+                if constexpr (kCross) {
+                    if (j >= e) {  // evaluated before, in its slot
+                        const CrossPair<D>& x = cross[c++];
+                        if (!x.touching) continue;
+                        bl.out[ne] = x;
+                        bl.outPartner[ne++] = Block::kNoPartner;
+                        continue;
+                    }
+                }
+                KernelVec<D> d = a.x - kernelVec(in.x[j]);
+                if (in.shift[k] != PairList<D>::kNoShift) d += kernelVec(in.shiftVec[in.shift[k]]);
+                const double rsum = a.radius + in.radius[j];
+                const double dist2 = norm2(d);
+                bl.owner[nl] = static_cast<std::uint32_t>(i);
+                bl.partner[nl] = j;
+                bl.slot[nl] = k;
+                bl.coeff[nl] = row + in.material[j];
+                storeRow<D>(bl.sep[nl].c, d, dist2);
+                if constexpr (Tangential::kHasHistory) {
+                    storeRow<D>(bl.spring[nl].c, kernelVec(in.history[k]), 0.0);
+                    in.history[k] = Vec<D>::zero();
+                }
+                if constexpr (kCross) {
+                    bl.entry[nl] = ne;
+                    bl.outPartner[ne] = j;
+                }
+                const bool touching = !(dist2 >= rsum * rsum);  // a NaN counts as touching: it must be seen
+                nl += touching;
+                ne += touching;
+            }
+            bl.ownerEnd[i - b0] = ne;
+        }
+        // (2) The law.
+        if (nl > 0) {
+            std::uint32_t padded = nl;
+            if constexpr (kLanes) {
+                // The last lanes repeat the last pair: the same result, written twice to the same places.
+                for (; padded % 4 != 0; ++padded) {
+                    const std::uint32_t s = nl - 1;
+                    bl.owner[padded] = bl.owner[s];
+                    bl.partner[padded] = bl.partner[s];
+                    bl.slot[padded] = bl.slot[s];
+                    bl.coeff[padded] = bl.coeff[s];
+                    bl.entry[padded] = bl.entry[s];
+                    bl.sep[padded] = bl.sep[s];
+                    bl.spring[padded] = bl.spring[s];
                 }
             }
-            PairForce<D> pf;
-            if (!evalPair<D, Normal, Tangential>(in, a, k, pf, worst, vir)) continue;
-            fi += pf.f;
-            nxi += pf.nxft;
-            f[j] = storedVec(kernelVec(f[j]) - pf.f);
-            nx[j] = storedVec(kernelVec(nx[j]) + pf.nxft);
-            ++nc;
+            evalBlock<D, Normal, Tangential, kCross, kLanes>(in, bl, padded);
         }
-        const ParticleTally t = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, a,
-                                                                      storedVec(fi), storedVec(nxi), worst, nc, then);
-        st.contacts += t.contacts;
-        if constexpr (kCross) virial[i] = vir;
-        else *virialSum += vir;
-        if (t.worst > st.maxOverlapRatio) {
-            st.maxOverlapRatio = t.worst;
-            st.worstParticle = i;
+        // (3) The sums, in pair order, and each particle finished.
+        std::uint32_t t = 0;
+        for (std::size_t i = b0; i < b1; ++i) {
+            const std::uint32_t k0 = first[i], k1 = first[i + 1];
+            std::size_t reach = k1 > k0 ? std::size_t{in.partner[k1 - 1]} + 1 : i + 1;
+            if constexpr (kCross) reach = std::min(reach, e);
+            startUpTo(std::max(reach, i + 1));
+            const Owner<D> a(in, i);
+            KernelVec<D> fi = kernelVec(f[i]);
+            KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
+            double worst = 0, vir = 0;
+            std::uint32_t nc = 0;
+            for (const std::uint32_t tEnd = bl.ownerEnd[i - b0]; t < tEnd; ++t) {
+                const CrossPair<D>& x = bl.out[t];
+                const KernelVec<D> pf = kernelVec(x.f);
+                const KernelVec<kAngDim<D>> pn = kernelVec(x.nxft);
+                fi += pf;
+                nxi += pn;
+                const std::uint32_t j = kCross ? bl.outPartner[t] : bl.partner[t];
+                if (!kCross || j != Block::kNoPartner) {
+                    f[j] = storedVec(kernelVec(f[j]) - pf);
+                    nx[j] = storedVec(kernelVec(nx[j]) + pn);
+                }
+                vir += x.virial;
+                worst = std::max(worst, x.overlap);
+                ++nc;
+            }
+            const ParticleTally pt = finishParticle<D, Normal, Tangential>(
+                p, in, walls, nw, wh, cs, time, i, a, storedVec(fi), storedVec(nxi), worst, nc, then);
+            st.contacts += pt.contacts;
+            if constexpr (kCross) virial[i] = vir;
+            else *virialSum += vir;
+            if (pt.worst > st.maxOverlapRatio) {
+                st.maxOverlapRatio = pt.worst;
+                st.worstParticle = i;
+            }
+            if (!pt.finite && st.nonFinite == ForceStats::kNone) st.nonFinite = i;
         }
-        if (!t.finite && st.nonFinite == ForceStats::kNone) st.nonFinite = i;
     }
     return st;
 }
@@ -297,8 +509,9 @@ template <int D, class Normal, class Tangential, bool kCross, class Then>
 /// Forces at the predicted state. sv/sw: mean velocities over the last step (StepMotion), which increment
 /// the tangential springs; the damping terms use the predicted velocities p.v, p.w. then(i) runs once particle
 /// i's force and torque are final, with them: then(i, f, torque) (it may change i's velocities, not its position;
-/// nothing reads them after).
-template <int D, class Normal, class Tangential, class Then>
+/// nothing reads them after). kLanes: the law on four pairs at once (kLanePairs) or one by one, for tests that
+/// hold the two to the same bits.
+template <int D, class Normal, class Tangential, bool kLanes = kLanePairs, class Then>
 ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wall<D>>& walls,
                          std::vector<Vec<D>>& wallHistory, const ContactSetup& cs, const Domain<D>& dom,
                          double time, double dt, const Vec<D>* sv, const Ang<D>* sw, ForceScratch<D>& s,
@@ -316,10 +529,11 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
     const int nt = n >= kParallelMin ? omp_get_max_threads() : 1;
     ForceStats st;
 
+    if (s.blocks.size() < static_cast<std::size_t>(nt)) s.blocks.resize(static_cast<std::size_t>(nt));
     if (nt <= 1) {
-        const RangeTally t = forceRange<D, Normal, Tangential, false>(p, in, first, wp, nw, wh, cs, time, g, 0, n,
-                                                                      nullptr, 0, nullptr, nullptr, nullptr,
-                                                                      &st.virial, then);
+        const RangeTally t = forceRange<D, Normal, Tangential, false, kLanes>(p, in, first, wp, nw, wh, cs, time,
+                                                                              g, 0, n, nullptr, 0, nullptr, nullptr,
+                                                                              nullptr, &st.virial, s.blocks[0], then);
         st.contacts = t.contacts;
         st.maxOverlapRatio = t.maxOverlapRatio;
         st.worstParticle = t.worstParticle;
@@ -354,9 +568,10 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
 #pragma omp for schedule(static, 1)
         for (int r = 0; r < nt; ++r) {
             const std::uint64_t* ci = sp.crossIn.data();
-            tally[r] = forceRange<D, Normal, Tangential, true>(
+            tally[r] = forceRange<D, Normal, Tangential, true, kLanes>(
                 p, in, first, wp, nw, wh, cs, time, g, sp.start[r], sp.start[r + 1], cross, sp.crossFirst[r],
-                ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1], s.virial.data(), nullptr, then);
+                ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1], s.virial.data(), nullptr,
+                s.blocks[static_cast<std::size_t>(r)], then);
         }
     }
     // The one-thread reductions, in the same order.
