@@ -115,6 +115,10 @@ struct LaneVec {
     }
 };
 
+/// Component k, or zeros past the last.
+template <int N>
+inline Lanes laneOr0(const LaneVec<N>& a, int k) { return k < N ? a.c[k] : Lanes(0.0); }
+
 template <int N>
 inline Lanes dot(const LaneVec<N>& a, const LaneVec<N>& b) {
     Lanes s = a[0] * b[0];
@@ -178,6 +182,22 @@ inline void transpose4(const double* r0, const double* r1, const double* r2, con
     out[3] = Lanes(_mm256_permute2f128_pd(ab1, cd1, 0x31));
 #else
     for (int k = 0; k < 4; ++k) out[k] = Lanes(Lanes::Values{r0[k], r1[k], r2[k], r3[k]});
+#endif
+}
+
+/// The other way: lane l of in[0..3] into row l (32-byte aligned).
+inline void transpose4(const Lanes in[4], double* r0, double* r1, double* r2, double* r3) {
+#ifdef __AVX__
+    const __m256d ab0 = _mm256_unpacklo_pd(in[0].v, in[1].v), ab1 = _mm256_unpackhi_pd(in[0].v, in[1].v);
+    const __m256d cd0 = _mm256_unpacklo_pd(in[2].v, in[3].v), cd1 = _mm256_unpackhi_pd(in[2].v, in[3].v);
+    _mm256_store_pd(r0, _mm256_permute2f128_pd(ab0, cd0, 0x20));
+    _mm256_store_pd(r1, _mm256_permute2f128_pd(ab1, cd1, 0x20));
+    _mm256_store_pd(r2, _mm256_permute2f128_pd(ab0, cd0, 0x31));
+    _mm256_store_pd(r3, _mm256_permute2f128_pd(ab1, cd1, 0x31));
+#else
+    double* r[4] = {r0, r1, r2, r3};
+    for (int l = 0; l < 4; ++l)
+        for (int k = 0; k < 4; ++k) r[l][k] = in[k][l];
 #endif
 }
 

@@ -60,32 +60,48 @@ struct CrossPair {
 };
 
 /// One thread's buffers for a block of particles in forceRange: the block's touching pairs as a list (in pair
-/// order), their inputs gathered for the contact law, and what each adds to its owner, in pair order. A block
-/// holds at most kPairs listed pairs (more only when one particle alone has more), so its buffers stay in L1.
+/// order), and what each adds to its owner. A block holds at most kPairs listed pairs (more only when one particle
+/// alone has more), so its buffers stay in L1.
 template <int D>
 struct PairBlock {
     static constexpr std::uint32_t kPairs = 128;   ///< listed pairs per block
     static constexpr std::uint32_t kOwners = 64;   ///< particles per block
     static constexpr std::uint32_t kNoPartner = 0xFFFFFFFFu;  ///< an entry taken from a cross pair's slot
-    /// Four doubles: a separation d then |d|^2, or a spring; the rows of four pairs are transposed into lanes.
+    /// Four doubles (a vector, zero-padded): the rows of four pairs are transposed into lanes and back.
     struct alignas(32) Row {
         double c[4];
     };
-    // The touching pairs the law evaluates (list index m), padded to a multiple of 4.
-    std::vector<std::uint32_t> owner, partner, slot, coeff, entry;
-    std::vector<Row> sep, spring;
+    /// What an entry adds to its owner: f = F on i in a (the virial r . F in a[3]); n x F_t in b (the overlap /
+    /// smaller radius in b[3]).
+    struct Entry {
+        Row a, b;
+    };
+    /// A touching pair for the law: owner i, partner j, pair slot k, index of the material pair's coefficients.
+    struct Item {
+        std::uint32_t owner, partner, slot, coeff;
+    };
+    /// The separation d = x_i - x_j (+ shift) and the spring of a touching pair.
+    struct Rows {
+        Row sep, spring;
+    };
+    // The touching pairs the law evaluates (list index m), padded to a multiple of 4 (one array each, so that
+    // the contact tests write through few pointers), and (threaded) the entry each fills.
+    std::vector<Item> items;
+    std::vector<Rows> rows;
+    std::vector<std::uint32_t> entry;
     // The entries of the block's owners, in pair order: evaluated pairs and (threaded) cross pairs.
-    std::vector<CrossPair<D>> out;
+    std::vector<Entry> out;
     std::vector<std::uint32_t> outPartner;  ///< j of each entry, kNoPartner for a cross pair
     std::vector<std::uint32_t> ownerEnd;    ///< the block's particle b0 + q has entries [ownerEnd[q-1], ownerEnd[q])
 
     /// Room for a block of `pairs` listed pairs.
     void fit(std::size_t pairs) {
         const std::size_t need = std::max<std::size_t>(pairs, kPairs) + 4;
-        if (owner.size() >= need) return;
-        for (auto* v : {&owner, &partner, &slot, &coeff, &entry, &outPartner}) v->resize(need);
-        sep.resize(need);
-        spring.resize(need);
+        if (items.size() >= need) return;
+        items.resize(need);
+        rows.resize(need);
+        entry.resize(need);
+        outPartner.resize(need);
         out.resize(need);
         ownerEnd.resize(kOwners + 1);
     }
@@ -273,85 +289,170 @@ inline constexpr bool kLanePairs = true;
 inline constexpr bool kLanePairs = false;
 #endif
 
-/// Stores a vector then, in the fourth place, a number (the squared length or 0) in a row of PairBlock.
+/// A vector into a zero-padded row of PairBlock.
 template <int D>
-inline void storeRow(double* row, const KernelVec<D>& v, double last) {
+inline void storeRow(double* row, const KernelVec<D>& v) {
 #ifdef __AVX__
     if constexpr (D == 3) {
-        _mm256_store_pd(row, _mm256_blend_pd(v.l, _mm256_set1_pd(last), 8));
+        _mm256_store_pd(row, v.l);
         return;
     }
 #endif
     const Vec<D> a = storedVec(v);
-    for (int k = 0; k < D; ++k) row[k] = a[k];
-    row[D] = last;
+    for (int k = 0; k < 4; ++k) row[k] = k < D ? a[k] : 0.0;
 }
 
-/// The law on the block's touching pairs [0, nl) (nl a multiple of 4 when kLanes): their springs go back to the
-/// pair list, their contributions to the block's entries.
+/// The first N numbers of a row as a vector.
+template <int N>
+inline KernelVec<N> rowVec(const double* row) {
+#ifdef __AVX__
+    if constexpr (N == 3) return Wide3{_mm256_blend_pd(_mm256_load_pd(row), _mm256_setzero_pd(), 8)};
+#endif
+    Vec<N> a;
+    for (int k = 0; k < N; ++k) a[k] = row[k];
+    return kernelVec(a);
+}
+
+/// Pass (1) over the block's particles [b0, b1): the contact test of each listed pair, without a branch on its
+/// outcome: the pair is written at the end of the list of touching pairs, which grows by one when it touches; its
+/// spring moves from the pair list to the block (the list keeps a zero, right for a pair not touching). Cross
+/// pairs (kCross, partner >= e) come from their slots, cross[c...]. Returns the number of touching pairs.
+template <int D, class Tangential, bool kCross>
+[[gnu::noinline]] std::uint32_t findTouching(const PairInputs<D>& in, const std::uint32_t* first, std::size_t b0,
+                                             std::size_t b1, std::size_t e, const CrossPair<D>* cross,
+                                             std::size_t& c, PairBlock<D>& bl) {
+    using Block = PairBlock<D>;
+    const Vec<D>* x = in.x;
+    const double* radius = in.radius;
+    const std::uint16_t* material = in.material;
+    const std::uint32_t* partner = in.partner;
+    const std::uint8_t* shift = in.shift;
+    Vec<D>* history = in.history;
+    typename Block::Item* items = bl.items.data();
+    typename Block::Rows* rows = bl.rows.data();
+    std::uint32_t* entry = bl.entry.data();
+    std::uint32_t* outPartner = bl.outPartner.data();
+    std::uint32_t nl = 0, ne = 0;
+    for (std::size_t i = b0; i < b1; ++i) {
+        const KernelVec<D> xi = kernelVec(x[i]);
+        const double ri = radius[i];
+        const std::uint32_t row = std::uint32_t{material[i]} * static_cast<std::uint32_t>(in.nMaterials);
+        for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
+            const std::uint32_t j = partner[k];
+            if constexpr (kCross) {
+                if (j >= e) {  // evaluated before, in its slot
+                    const CrossPair<D>& q = cross[c++];
+                    if (!q.touching) continue;
+                    typename Block::Entry& o = bl.out[ne];
+                    storeRow<D>(o.a.c, kernelVec(q.f));
+                    o.a.c[3] = q.virial;
+                    storeRow<kAngDim<D>>(o.b.c, kernelVec(q.nxft));
+                    o.b.c[3] = q.overlap;
+                    outPartner[ne++] = Block::kNoPartner;
+                    continue;
+                }
+            }
+            KernelVec<D> d = xi - kernelVec(x[j]);
+            if (shift[k] != PairList<D>::kNoShift) d += kernelVec(in.shiftVec[shift[k]]);
+            const double rsum = ri + radius[j];
+            const double dist2 = norm2(d);
+            items[nl] = {static_cast<std::uint32_t>(i), j, k, row + material[j]};
+            storeRow<D>(rows[nl].sep.c, d);
+            if constexpr (Tangential::kHasHistory) {
+                storeRow<D>(rows[nl].spring.c, kernelVec(history[k]));
+                history[k] = Vec<D>::zero();
+            }
+            if constexpr (kCross) {
+                entry[nl] = ne;
+                outPartner[ne] = j;
+            }
+            const bool touching = !(dist2 >= rsum * rsum);  // a NaN counts as touching: it must be seen
+            nl += touching;
+            ne += touching;
+        }
+        bl.ownerEnd[i - b0] = ne;
+    }
+    return nl;
+}
+
+/// Pass (2): the law on the block's touching pairs [0, nl) (nl a multiple of 4 when kLanes): their springs go
+/// back to the pair list, their contributions to the block's entries.
 template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
-[[gnu::always_inline]] inline void evalBlock(const PairInputs<D>& in, PairBlock<D>& bl, std::uint32_t nl) {
+[[gnu::noinline]] void evalTouching(const PairInputs<D>& in, PairBlock<D>& bl, std::uint32_t nl) {
     using Row = typename PairBlock<D>::Row;
+    using Entry = typename PairBlock<D>::Entry;
     constexpr int A = kAngDim<D>;
+    const typename PairBlock<D>::Item* items = bl.items.data();
+    const typename PairBlock<D>::Rows* rows = bl.rows.data();
+    const std::uint32_t* entry = bl.entry.data();
+    Entry* out = bl.out.data();
+    Vec<D>* history = in.history;
     for (std::uint32_t m = 0; m < nl; m += kLanes ? 4 : 1) {
         if constexpr (kLanes) {
-            const LaneIndex ii = loadIndex(&bl.owner[m]), jj = loadIndex(&bl.partner[m]);
+            const auto* it = items + m;
+            const LaneIndex ii = {std::int32_t(it[0].owner), std::int32_t(it[1].owner), std::int32_t(it[2].owner),
+                                  std::int32_t(it[3].owner)};
+            const LaneIndex jj = {std::int32_t(it[0].partner), std::int32_t(it[1].partner),
+                                  std::int32_t(it[2].partner), std::int32_t(it[3].partner)};
+            const LaneIndex cc = {std::int32_t(it[0].coeff), std::int32_t(it[1].coeff), std::int32_t(it[2].coeff),
+                                  std::int32_t(it[3].coeff)};
+            const auto* rw = rows + m;
             Lanes t[4];
-            const Row* r = &bl.sep[m];
-            transpose4(r[0].c, r[1].c, r[2].c, r[3].c, t);
+            transpose4(rw[0].sep.c, rw[1].sep.c, rw[2].sep.c, rw[3].sep.c, t);
             LaneVec<D> d;
             for (int k = 0; k < D; ++k) d.c[k] = t[k];
-            const Lanes dist2 = t[D];
             LaneVec<D> xi = LaneVec<D>::zero();
             if constexpr (Tangential::kHasHistory) {
-                r = &bl.spring[m];
-                transpose4(r[0].c, r[1].c, r[2].c, r[3].c, t);
+                transpose4(rw[0].spring.c, rw[1].spring.c, rw[2].spring.c, rw[3].spring.c, t);
                 for (int k = 0; k < D; ++k) xi.c[k] = t[k];
             }
-            const LanePairCoeffs c(in.table, loadIndex(&bl.coeff[m]));
+            const LanePairCoeffs c(in.table, cc);
             LaneVec<D> f;
             LaneVec<A> nxft;
             Lanes vir, overlap;
-            contactLaw<Normal, Tangential>(c, d, dist2, gather(in.radius, ii), gather(in.radius, jj),
+            contactLaw<Normal, Tangential>(c, d, norm2(d), gather(in.radius, ii), gather(in.radius, jj),
                                            gather(in.invMass, ii), gather(in.invMass, jj), gather(in.v, ii),
                                            gather(in.v, jj), gather(in.w, ii), gather(in.w, jj), gather(in.sv, ii),
                                            gather(in.sv, jj), gather(in.sw, ii), gather(in.sw, jj), xi, in.clip,
                                            in.dt, f, nxft, vir, overlap);
-            for (int l = 0; l < 4; ++l) {
-                if constexpr (Tangential::kHasHistory) in.history[bl.slot[m + l]] = xi.lane(l);
-                CrossPair<D>& o = bl.out[kCross ? bl.entry[m + l] : m + l];
-                o.f = f.lane(l);
-                o.nxft = nxft.lane(l);
-                o.virial = vir[l];
-                o.overlap = overlap[l];
+            // Back to rows, one per pair: the spring, then the entry.
+            const Lanes zero(0.0);
+            Row r[4];
+            if constexpr (Tangential::kHasHistory) {
+                const Lanes h[4] = {xi.c[0], laneOr0(xi, 1), laneOr0(xi, 2), zero};
+                transpose4(h, r[0].c, r[1].c, r[2].c, r[3].c);
+                for (int l = 0; l < 4; ++l) {
+                    Vec<D> hv;
+                    for (int k = 0; k < D; ++k) hv[k] = r[l].c[k];
+                    history[it[l].slot] = hv;
+                }
             }
+            Entry* o[4];
+            for (int l = 0; l < 4; ++l) o[l] = out + (kCross ? entry[m + l] : m + l);
+            const Lanes fa[4] = {f.c[0], laneOr0(f, 1), laneOr0(f, 2), vir};
+            transpose4(fa, o[0]->a.c, o[1]->a.c, o[2]->a.c, o[3]->a.c);
+            const Lanes nb[4] = {nxft.c[0], laneOr0(nxft, 1), laneOr0(nxft, 2), overlap};
+            transpose4(nb, o[0]->b.c, o[1]->b.c, o[2]->b.c, o[3]->b.c);
         } else {
             using V = KernelVec<D>;
-            using VA = KernelVec<A>;
-            const std::uint32_t i = bl.owner[m], j = bl.partner[m];
-            const double* r = bl.sep[m].c;
-            Vec<D> d;
-            for (int k = 0; k < D; ++k) d[k] = r[k];
+            const std::uint32_t i = items[m].owner, j = items[m].partner;
+            const V d = rowVec<D>(rows[m].sep.c);
             V xi = V::zero();
-            if constexpr (Tangential::kHasHistory) {
-                Vec<D> h;
-                for (int k = 0; k < D; ++k) h[k] = bl.spring[m].c[k];
-                xi = kernelVec(h);
-            }
+            if constexpr (Tangential::kHasHistory) xi = rowVec<D>(rows[m].spring.c);
             V f;
-            VA nxft;
+            KernelVec<A> nxft;
             double vir, overlap;
-            contactLaw<Normal, Tangential>(in.table[bl.coeff[m]], kernelVec(d), r[D], in.radius[i], in.radius[j],
+            contactLaw<Normal, Tangential>(in.table[items[m].coeff], d, norm2(d), in.radius[i], in.radius[j],
                                            in.invMass[i], in.invMass[j], kernelVec(in.v[i]), kernelVec(in.v[j]),
                                            kernelVec(in.w[i]), kernelVec(in.w[j]), kernelVec(in.sv[i]),
                                            kernelVec(in.sv[j]), kernelVec(in.sw[i]), kernelVec(in.sw[j]), xi,
                                            in.clip, in.dt, f, nxft, vir, overlap);
-            if constexpr (Tangential::kHasHistory) in.history[bl.slot[m]] = storedVec(xi);
-            CrossPair<D>& o = bl.out[kCross ? bl.entry[m] : m];
-            o.f = storedVec(f);
-            o.nxft = storedVec(nxft);
-            o.virial = vir;
-            o.overlap = overlap;
+            if constexpr (Tangential::kHasHistory) history[items[m].slot] = storedVec(xi);
+            Entry& o = out[kCross ? entry[m] : m];
+            storeRow<D>(o.a.c, f);
+            o.a.c[3] = vir;
+            storeRow<A>(o.b.c, nxft);
+            o.b.c[3] = overlap;
         }
     }
 }
@@ -361,15 +462,13 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
 /// [b, e), by partner then pair. Per-particle virial sums go to virial[i] when a thread split needs them kept
 /// apart, else into *virialSum (in particle order either way).
 ///
-/// The particles go in blocks of a few dozen, each in three passes. (1) The contact test of every listed pair,
-/// without a branch: each pair is written at the end of the list of touching pairs, which grows by one when it
-/// touches; its spring moves from the pair list to the block (the pair list keeps a zero, which is right for a
-/// pair not touching). (2) The contact law on the touching pairs, four at a time in lanes (evalBlock): their long
-/// chains of square roots and divisions overlap instead of waiting one behind the other. (3) In pair order, as
-/// with one pair at a time, each contribution is added to its owner and subtracted from its partner, and each
-/// particle is finished. The law reads positions and velocities only, which no particle of the block or after it
-/// has had changed yet (finishing changes a particle's velocity, and comes after its last pair), so the three
-/// passes give the bits of evaluating each pair as its owner comes.
+/// The particles go in blocks of a few dozen, each in three passes: (1) the contact tests, without a branch on
+/// their outcome (findTouching); (2) the contact law on the touching pairs, four at a time in lanes (evalTouching),
+/// where their long chains of square roots and divisions overlap instead of waiting one behind the other; (3) in
+/// pair order, as when each pair was evaluated as its owner came, each contribution added to its owner and
+/// subtracted from its partner, and each particle finished. The law reads positions and velocities only, which no
+/// particle of the block or after it has had changed yet (finishing changes a particle's velocity, after its last
+/// pair), so the passes give the same bits as one pair at a time.
 template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class Then>
 [[gnu::always_inline]] inline RangeTally forceRange(Particles<D>& p, const PairInputs<D>& in,
                                                      const std::uint32_t* first, const Wall<D>* walls, std::size_t nw,
@@ -407,64 +506,24 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
         b1 = b0 + 1;
         while (b1 < e && b1 - b0 < Block::kOwners && first[b1 + 1] - first[b0] <= Block::kPairs) ++b1;
         bl.fit(first[b1] - first[b0]);
-        // (1) The contact tests.
-        std::uint32_t nl = 0, ne = 0;
-        for (std::size_t i = b0; i < b1; ++i) {
-            const Owner<D> a(in, i);
-            const std::uint32_t row = static_cast<std::uint32_t>(a.coeffRow - in.table);
-            for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
-                const std::uint32_t j = in.partner[k];
-                if constexpr (kCross) {
-                    if (j >= e) {  // evaluated before, in its slot
-                        const CrossPair<D>& x = cross[c++];
-                        if (!x.touching) continue;
-                        bl.out[ne] = x;
-                        bl.outPartner[ne++] = Block::kNoPartner;
-                        continue;
-                    }
-                }
-                KernelVec<D> d = a.x - kernelVec(in.x[j]);
-                if (in.shift[k] != PairList<D>::kNoShift) d += kernelVec(in.shiftVec[in.shift[k]]);
-                const double rsum = a.radius + in.radius[j];
-                const double dist2 = norm2(d);
-                bl.owner[nl] = static_cast<std::uint32_t>(i);
-                bl.partner[nl] = j;
-                bl.slot[nl] = k;
-                bl.coeff[nl] = row + in.material[j];
-                storeRow<D>(bl.sep[nl].c, d, dist2);
-                if constexpr (Tangential::kHasHistory) {
-                    storeRow<D>(bl.spring[nl].c, kernelVec(in.history[k]), 0.0);
-                    in.history[k] = Vec<D>::zero();
-                }
-                if constexpr (kCross) {
-                    bl.entry[nl] = ne;
-                    bl.outPartner[ne] = j;
-                }
-                const bool touching = !(dist2 >= rsum * rsum);  // a NaN counts as touching: it must be seen
-                nl += touching;
-                ne += touching;
-            }
-            bl.ownerEnd[i - b0] = ne;
-        }
-        // (2) The law.
+        const std::uint32_t nl = findTouching<D, Tangential, kCross>(in, first, b0, b1, e, cross, c, bl);
         if (nl > 0) {
             std::uint32_t padded = nl;
             if constexpr (kLanes) {
                 // The last lanes repeat the last pair: the same result, written twice to the same places.
                 for (; padded % 4 != 0; ++padded) {
                     const std::uint32_t s = nl - 1;
-                    bl.owner[padded] = bl.owner[s];
-                    bl.partner[padded] = bl.partner[s];
-                    bl.slot[padded] = bl.slot[s];
-                    bl.coeff[padded] = bl.coeff[s];
+                    bl.items[padded] = bl.items[s];
+                    bl.rows[padded] = bl.rows[s];
                     bl.entry[padded] = bl.entry[s];
-                    bl.sep[padded] = bl.sep[s];
-                    bl.spring[padded] = bl.spring[s];
                 }
             }
-            evalBlock<D, Normal, Tangential, kCross, kLanes>(in, bl, padded);
+            evalTouching<D, Normal, Tangential, kCross, kLanes>(in, bl, padded);
         }
         // (3) The sums, in pair order, and each particle finished.
+        const typename Block::Entry* out = bl.out.data();
+        const std::uint32_t* outPartner = bl.outPartner.data();
+        const typename Block::Item* items = bl.items.data();
         std::uint32_t t = 0;
         for (std::size_t i = b0; i < b1; ++i) {
             const std::uint32_t k0 = first[i], k1 = first[i + 1];
@@ -477,18 +536,18 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
             double worst = 0, vir = 0;
             std::uint32_t nc = 0;
             for (const std::uint32_t tEnd = bl.ownerEnd[i - b0]; t < tEnd; ++t) {
-                const CrossPair<D>& x = bl.out[t];
-                const KernelVec<D> pf = kernelVec(x.f);
-                const KernelVec<kAngDim<D>> pn = kernelVec(x.nxft);
+                const typename Block::Entry& x = out[t];
+                const KernelVec<D> pf = rowVec<D>(x.a.c);
+                const KernelVec<kAngDim<D>> pn = rowVec<kAngDim<D>>(x.b.c);
                 fi += pf;
                 nxi += pn;
-                const std::uint32_t j = kCross ? bl.outPartner[t] : bl.partner[t];
+                const std::uint32_t j = kCross ? outPartner[t] : items[t].partner;
                 if (!kCross || j != Block::kNoPartner) {
                     f[j] = storedVec(kernelVec(f[j]) - pf);
                     nx[j] = storedVec(kernelVec(nx[j]) + pn);
                 }
-                vir += x.virial;
-                worst = std::max(worst, x.overlap);
+                vir += x.a.c[3];
+                worst = std::max(worst, x.b.c[3]);
                 ++nc;
             }
             const ParticleTally pt = finishParticle<D, Normal, Tangential>(
