@@ -93,6 +93,7 @@ struct PairBlock {
     std::vector<Entry> out;
     std::vector<std::uint32_t> outPartner;  ///< j of each entry, kNoPartner for a cross pair
     std::vector<std::uint32_t> ownerEnd;    ///< the block's particle b0 + q has entries [ownerEnd[q-1], ownerEnd[q])
+    std::size_t reach = 0;                  ///< 1 + the largest partner of the block's pairs (cross pairs aside)
 
     /// Room for a block of `pairs` listed pairs.
     void fit(std::size_t pairs) {
@@ -332,7 +333,7 @@ template <int D, class Tangential, bool kCross>
     typename Block::Rows* rows = bl.rows.data();
     std::uint32_t* entry = bl.entry.data();
     std::uint32_t* outPartner = bl.outPartner.data();
-    std::uint32_t nl = 0, ne = 0;
+    std::uint32_t nl = 0, ne = 0, last = 0;
     for (std::size_t i = b0; i < b1; ++i) {
         const KernelVec<D> xi = kernelVec(x[i]);
         const double ri = radius[i];
@@ -352,6 +353,7 @@ template <int D, class Tangential, bool kCross>
                     continue;
                 }
             }
+            last = std::max(last, j);
             KernelVec<D> d = xi - kernelVec(x[j]);
             if (shift[k] != PairList<D>::kNoShift) d += kernelVec(in.shiftVec[shift[k]]);
             const double rsum = ri + radius[j];
@@ -372,6 +374,7 @@ template <int D, class Tangential, bool kCross>
         }
         bl.ownerEnd[i - b0] = ne;
     }
+    bl.reach = std::max<std::size_t>(std::size_t{last} + 1, b1);
     return nl;
 }
 
@@ -481,9 +484,9 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
     Vec<D>* f = p.f.data();
     Ang<D>* nx = p.torque.data();  // holds the sums of n x F_t until the particle is finished
     const double* mass = p.mass.data();
-    // A particle's sums start (gravity, then the cross pairs where it is the partner) just before the first pair
-    // that adds to them: particles [b, done) have started. Each row is sorted by partner, so its last pair reaches
-    // farthest; starting the sums there, not in a pass of their own, keeps them in cache until they are used.
+    // A particle's sums start (gravity, then the cross pairs where it is the partner) just before the first block
+    // whose pairs add to them: particles [b, done) have started. Starting the sums there, not in a pass of their
+    // own, keeps them in cache until they are used.
     std::size_t done = b;
     const std::uint64_t* q = crossIn;
     auto startUpTo = [&](std::size_t end) {
@@ -524,12 +527,10 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
         const typename Block::Entry* out = bl.out.data();
         const std::uint32_t* outPartner = bl.outPartner.data();
         const typename Block::Item* items = bl.items.data();
+        // Every particle that the block's pairs add to starts here, once for the block.
+        startUpTo(bl.reach);
         std::uint32_t t = 0;
         for (std::size_t i = b0; i < b1; ++i) {
-            const std::uint32_t k0 = first[i], k1 = first[i + 1];
-            std::size_t reach = k1 > k0 ? std::size_t{in.partner[k1 - 1]} + 1 : i + 1;
-            if constexpr (kCross) reach = std::min(reach, e);
-            startUpTo(std::max(reach, i + 1));
             const Owner<D> a(in, i);
             KernelVec<D> fi = kernelVec(f[i]);
             KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
