@@ -3,6 +3,7 @@
 // particle-wall contacts: a wall is a partner of infinite mass and radius (m_eff = m, R_eff = a).
 #include <cmath>
 
+#include "core/lanes.hpp"
 #include "core/vec.hpp"
 
 namespace haet {
@@ -29,24 +30,57 @@ struct PairCoeffs {
     double beta0 = 1;        ///< Walton's sticking tangential restitution
 };
 
-/// Normal force magnitude and the contact's secant stiffness (for the tangential spring).
-struct NormalResult {
-    double fn;  ///< normal force on i along n [N]; clipped at 0 unless attraction is allowed
-    double k;   ///< secant stiffness F_el/delta [N/m]
+/// The coefficients of four material pairs side by side, one per lane (the force loop's four contacts at once).
+struct LanePairCoeffs {
+    Lanes knConst, knPerMeff, gnPerMeff, hertzK, dissipationTime, tsujiAlpha, ktRatio, ktConst, gtPerMeff, mu;
+
+    /// Lane l holds table[idx[l]].
+    LanePairCoeffs(const PairCoeffs* table, LaneIndex idx) {
+        static_assert(sizeof(PairCoeffs) % sizeof(double) == 0);
+        const double* base = reinterpret_cast<const double*>(table);
+        const LaneIndex at = idx * static_cast<std::int32_t>(sizeof(PairCoeffs) / sizeof(double));
+        auto field = [&](const double PairCoeffs::*m) {
+            return gather(base + (reinterpret_cast<const double*>(&(table->*m)) - base), at);
+        };
+        knConst = field(&PairCoeffs::knConst);
+        knPerMeff = field(&PairCoeffs::knPerMeff);
+        gnPerMeff = field(&PairCoeffs::gnPerMeff);
+        hertzK = field(&PairCoeffs::hertzK);
+        dissipationTime = field(&PairCoeffs::dissipationTime);
+        tsujiAlpha = field(&PairCoeffs::tsujiAlpha);
+        ktRatio = field(&PairCoeffs::ktRatio);
+        ktConst = field(&PairCoeffs::ktConst);
+        gtPerMeff = field(&PairCoeffs::gtPerMeff);
+        mu = field(&PairCoeffs::mu);
+    }
 };
+
+// The laws below are written once for one contact (S = double, C = PairCoeffs, vectors Vec<D> or Wide3) and for
+// four in lanes (S = Lanes, C = LanePairCoeffs, vectors LaneVec<D>): core/lanes.hpp. A branch is a select() of
+// the values both sides give, and the work of a side is skipped when no lane needs it (anyOf).
+
+/// Normal force magnitude and the contact's secant stiffness (for the tangential spring).
+template <class S>
+struct NormalResultOf {
+    S fn;  ///< normal force on i along n [N]; clipped at 0 unless attraction is allowed
+    S k;   ///< secant stiffness F_el/delta [N/m]
+};
+using NormalResult = NormalResultOf<double>;
 
 /// Linear spring-dashpot, F = k_n delta + gamma_n delta_dot (B.2). deltaDot = -g_n [m/s].
 struct LinearNormal {
-    static NormalResult eval(const PairCoeffs& c, double delta, double deltaDot, double meff, double /*reff*/) {
-        const double kn = c.knConst + c.knPerMeff * meff;
+    template <class C, class S>
+    static NormalResultOf<S> eval(const C& c, S delta, S deltaDot, S meff, S /*reff*/) {
+        const S kn = c.knConst + c.knPerMeff * meff;
         return {kn * delta + c.gnPerMeff * meff * deltaDot, kn};
     }
 };
 
 /// Hertz with viscoelastic damping (Brilliantov et al. 1996; B.3): F = rho delta^{3/2} + A* rho sqrt(delta) delta_dot.
 struct HertzViscoNormal {
-    static NormalResult eval(const PairCoeffs& c, double delta, double deltaDot, double /*meff*/, double reff) {
-        const double k = c.hertzK * std::sqrt(reff * delta);  // secant stiffness rho sqrt(delta)
+    template <class C, class S>
+    static NormalResultOf<S> eval(const C& c, S delta, S deltaDot, S /*meff*/, S reff) {
+        const S k = c.hertzK * sqrtOf(reff * delta);  // secant stiffness rho sqrt(delta)
         return {k * (delta + c.dissipationTime * deltaDot), k};
     }
 };
@@ -54,10 +88,11 @@ struct HertzViscoNormal {
 /// Hertz with Tsuji damping: F = k_H delta^{3/2} + alpha sqrt(2 m_eff k_H) delta^{1/4} delta_dot, k_H = hertzK sqrt(R).
 /// The mass in the damping is 2 m_eff: Tsuji's alpha(e) fit assumes the particle mass (PHYSICS.md B.3 pitfall).
 struct HertzTsujiNormal {
-    static NormalResult eval(const PairCoeffs& c, double delta, double deltaDot, double meff, double reff) {
-        const double kH = c.hertzK * std::sqrt(reff);
-        const double sd = std::sqrt(delta);
-        const double damp = c.tsujiAlpha * std::sqrt(2.0 * meff * kH) * std::sqrt(sd);
+    template <class C, class S>
+    static NormalResultOf<S> eval(const C& c, S delta, S deltaDot, S meff, S reff) {
+        const S kH = c.hertzK * sqrtOf(reff);
+        const S sd = sqrtOf(delta);
+        const S damp = c.tsujiAlpha * sqrtOf(2.0 * meff * kH) * sqrtOf(sd);
         return {kH * delta * sd + damp * deltaDot, kH * sd};
     }
 };
@@ -71,8 +106,8 @@ inline double tsujiAlpha(double e) {
 /// No tangential force.
 struct NoTangential {
     static constexpr bool kHasHistory = false;
-    template <class V>
-    static V eval(const PairCoeffs&, double, double, double, const V&, const V&, const V&, V&, double) {
+    template <class C, class S, class V>
+    static V eval(const C&, S, S, S, const V&, const V&, const V&, V&, double) {
         return V::zero();
     }
 };
@@ -83,30 +118,33 @@ struct NoTangential {
 /// included (the law removes it), so that xi grows by the true relative displacement.
 struct SpringTangential {
     static constexpr bool kHasHistory = true;
-    template <class V>  // Vec<D>, or Wide3 (core/wide3.hpp)
-    [[gnu::always_inline]] static inline V eval(const PairCoeffs& c, double fn, double kNormal, double meff,
-                                                const V& n, const V& gt, const V& gStep, V& xi, double dt) {
+    template <class C, class S, class V>  // V: Vec<D> or Wide3 (core/wide3.hpp) with S = double; LaneVec<D>, Lanes
+    [[gnu::always_inline]] static inline V eval(const C& c, S fn, S kNormal, S meff, const V& n, const V& gt,
+                                                const V& gStep, V& xi, double dt) {
         // The contact plane turns with the pair: xi is brought into it keeping its length (Luding 2008), then
         // grows by the step's displacement. Both go through one projection P(v) = v - n (n . v), which is linear:
         // P(s xi) + P(g dt) = P(s xi + g dt); and |P(xi)|^2 = |xi|^2 - (n . xi)^2 for a unit n.
-        const double len2 = norm2(xi);
-        double scale = 1;
-        if (len2 > 0) {
-            const double along = dot(n, xi);
-            const double l2new = len2 - along * along;
-            scale = l2new > 0 ? std::sqrt(len2 / l2new) : 0.0;  // a spring along n has no direction left
+        const S len2 = norm2(xi);
+        S scale = 1;
+        if (anyOf(len2 > 0)) {
+            const S along = dot(n, xi);
+            const S l2new = len2 - along * along;
+            // A spring along n has no direction left: 0.
+            scale = select(len2 > 0, select(l2new > 0, sqrtOf(len2 / l2new), S(0.0)), scale);
         }
         const V grown = xi * scale + gStep * dt;
         xi = grown - n * dot(n, grown);
-        const double kt = c.ktConst > 0 ? c.ktConst : c.ktRatio * kNormal;
-        const double gammaT = c.gtPerMeff * meff;
+        const S kt = select(c.ktConst > 0, c.ktConst, c.ktRatio * kNormal);
+        const S gammaT = c.gtPerMeff * meff;
         V ft = xi * (-kt) - gt * gammaT;
-        const double ft2 = norm2(ft);
-        const double fmax = c.mu * fn;
-        if (ft2 > fmax * fmax) {
+        const S ft2 = norm2(ft);
+        const S fmax = c.mu * fn;
+        const auto sliding = ft2 > fmax * fmax;
+        if (anyOf(sliding)) {
             // Sliding: the force sits on the Coulomb cone and the spring is shortened to match it.
-            ft *= fmax / std::sqrt(ft2);
-            if (kt > 0) xi = (ft + gt * gammaT) * (-1.0 / kt);
+            const V onCone = ft * (fmax / sqrtOf(ft2));
+            ft = select(sliding, onCone, ft);
+            xi = select(sliding & (kt > 0), (ft + gt * gammaT) * (-1.0 / kt), xi);
         }
         return ft;
     }

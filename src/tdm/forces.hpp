@@ -23,6 +23,7 @@
 
 #include "contact/laws.hpp"
 #include "contact/setup.hpp"
+#include "core/lanes.hpp"
 #include "core/particles.hpp"
 #include "core/wide3.hpp"
 #include "geometry/domain.hpp"
@@ -47,7 +48,8 @@ struct RangeTally {
     std::size_t nonFinite = ForceStats::kNone;
 };
 
-/// A cross pair evaluated before the ranges run (threaded path).
+/// What one pair adds to its owner (its partner gets -f and n x F_t): a cross pair evaluated before the ranges
+/// run (threaded path), or an entry of a PairBlock.
 template <int D>
 struct CrossPair {
     Vec<D> f;         ///< force on i [N]
@@ -57,9 +59,59 @@ struct CrossPair {
     bool touching;
 };
 
+/// One thread's buffers for a block of particles in forceRange: the block's touching pairs as a list (in pair
+/// order), and what each adds to its owner. A block holds at most kPairs listed pairs (more only when one particle
+/// alone has more), so its buffers stay in L1.
+template <int D>
+struct PairBlock {
+    static constexpr std::uint32_t kPairs = 128;   ///< listed pairs per block
+    static constexpr std::uint32_t kOwners = 64;   ///< particles per block
+    static constexpr std::uint32_t kNoPartner = 0xFFFFFFFFu;  ///< an entry taken from a cross pair's slot
+    /// Four doubles (a vector, zero-padded): the rows of four pairs are transposed into lanes and back.
+    struct alignas(32) Row {
+        double c[4];
+    };
+    /// What an entry adds to its owner: f = F on i in a (the virial r . F in a[3]); n x F_t in b (the overlap /
+    /// smaller radius in b[3]).
+    struct Entry {
+        Row a, b;
+    };
+    /// A touching pair for the law: owner i, partner j, pair slot k, index of the material pair's coefficients.
+    struct Item {
+        std::uint32_t owner, partner, slot, coeff;
+    };
+    /// The separation d = x_i - x_j (+ shift) and the spring of a touching pair.
+    struct Rows {
+        Row sep, spring;
+    };
+    // The touching pairs the law evaluates (list index m), padded to a multiple of 4 (one array each, so that
+    // the contact tests write through few pointers), and (threaded) the entry each fills.
+    std::vector<Item> items;
+    std::vector<Rows> rows;
+    std::vector<std::uint32_t> entry;
+    // The entries of the block's owners, in pair order: evaluated pairs and (threaded) cross pairs.
+    std::vector<Entry> out;
+    std::vector<std::uint32_t> outPartner;  ///< j of each entry, kNoPartner for a cross pair
+    std::vector<std::uint32_t> ownerEnd;    ///< the block's particle b0 + q has entries [ownerEnd[q-1], ownerEnd[q])
+    std::size_t reach = 0;                  ///< 1 + the largest partner of the block's pairs (cross pairs aside)
+
+    /// Room for a block of `pairs` listed pairs.
+    void fit(std::size_t pairs) {
+        const std::size_t need = std::max<std::size_t>(pairs, kPairs) + 4;
+        if (items.size() >= need) return;
+        items.resize(need);
+        rows.resize(need);
+        entry.resize(need);
+        outPartner.resize(need);
+        out.resize(need);
+        ownerEnd.resize(kOwners + 1);
+    }
+};
+
 /// Buffers of the threaded paths, kept between steps so that no step allocates (one thread needs none).
 template <int D>
 struct ForceScratch {
+    std::vector<PairBlock<D>> blocks;  ///< one per thread (forceRange)
     std::vector<CrossPair<D>> cross;  ///< the disk loop's cross pairs (PairList::split)
     std::vector<Vec<D>> pairForce;    ///< polygon loop: force on i of each pair [N]
     std::vector<double> maxOverlap;   ///< polygon loop, per particle: largest overlap / smaller radius
@@ -111,6 +163,41 @@ struct Owner {
           coeffRow(in.table + in.material[i] * in.nMaterials) {}
 };
 
+/// The contact law of a touching pair, from the pair's separation d = x_i - x_j (+ shift), |d|^2, radii, inverse
+/// masses and velocities: F on i, n x F_t and the spring xi (updated), r . F and overlap / smaller radius.
+/// Written once for one pair (S = double) and for four in lanes (S = Lanes; core/lanes.hpp): the same operations
+/// in the same order, so a pair gets the same bits either way.
+template <class Normal, class Tangential, class C, class S, class V, class A>
+[[gnu::always_inline]] inline void contactLaw(const C& c, const V& d, S dist2, S ri, S rj, S invMi, S invMj,
+                                              const V& vi, const V& vj, const A& wi, const A& wj, const V& svi,
+                                              const V& svj, const A& swi, const A& swj, V& xi, bool clip,
+                                              double dt, V& f, A& nxft, S& virial, S& overlap) {
+    const S rsum = ri + rj;
+    const S dist = sqrtOf(dist2);
+    const V nrm = d * (1.0 / dist);
+    const S delta = rsum - dist;
+    // A frozen particle has 1/m = 0: it acts as infinitely heavy. (Frozen-frozen pairs are never listed.)
+    const S meff = 1.0 / (invMi + invMj);
+    const S reff = ri * rj / rsum;
+    const V dv = vi - vj;
+    const S gn = dot(dv, nrm);
+    NormalResultOf<S> nr = Normal::eval(c, delta, -gn, meff, reff);
+    if (clip) nr.fn = select(nr.fn < 0, S(0.0), nr.fn);
+    f = nrm * nr.fn;
+    if constexpr (Tangential::kHasHistory) {
+        // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
+        const V gt = dv - nrm * gn - cross(wi * ri + wj * rj, nrm);
+        const V gs = svi - svj - cross(swi * ri + swj * rj, nrm);
+        const V ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, xi, dt);
+        f += ft;
+        nxft = cross(nrm, ft);
+    } else {
+        nxft = A::zero();
+    }
+    virial = dot(d, f);
+    overlap = delta / minOf(ri, rj);
+}
+
 /// Evaluates pair slot k of owner a. Returns false when the pair is not touching (its spring is cleared).
 template <int D, class Normal, class Tangential>
 [[gnu::always_inline]] inline bool evalPair(const PairInputs<D>& in, const Owner<D>& a, std::uint32_t k,
@@ -128,32 +215,15 @@ template <int D, class Normal, class Tangential>
         if constexpr (Tangential::kHasHistory) in.history[k] = Vec<D>::zero();
         return false;
     }
-    const double dist = std::sqrt(dist2);
-    const V nrm = d * (1.0 / dist);
-    const double delta = rsum - dist;
-    // A frozen particle has 1/m = 0: it acts as infinitely heavy. (Frozen-frozen pairs are never listed.)
-    const double meff = 1.0 / (a.invMass + in.invMass[j]);
-    const double reff = ri * rj / rsum;
-    const V dv = a.v - kernelVec(in.v[j]);
-    const double gn = dot(dv, nrm);
-    const PairCoeffs& c = a.coeffRow[in.material[j]];
-    NormalResult nr = Normal::eval(c, delta, -gn, meff, reff);
-    if (in.clip && nr.fn < 0) nr.fn = 0;
-    out.f = nrm * nr.fn;
-    if constexpr (Tangential::kHasHistory) {
-        // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
-        const V gt = dv - nrm * gn - cross(a.w * ri + kernelVec(in.w[j]) * rj, nrm);
-        const V gs = a.sv - kernelVec(in.sv[j]) - cross(a.sw * ri + kernelVec(in.sw[j]) * rj, nrm);
-        V xi = kernelVec(in.history[k]);
-        const V ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, xi, in.dt);
-        in.history[k] = storedVec(xi);
-        out.f += ft;
-        out.nxft = cross(nrm, ft);
-    } else {
-        out.nxft = KernelVec<kAngDim<D>>::zero();
-    }
-    virial += dot(d, out.f);
-    overlapRatio = std::max(overlapRatio, delta / std::min(ri, rj));
+    V xi = V::zero();
+    if constexpr (Tangential::kHasHistory) xi = kernelVec(in.history[k]);
+    double vir, overlap;
+    contactLaw<Normal, Tangential>(a.coeffRow[in.material[j]], d, dist2, ri, rj, a.invMass, in.invMass[j], a.v,
+                                   kernelVec(in.v[j]), a.w, kernelVec(in.w[j]), a.sv, kernelVec(in.sv[j]), a.sw,
+                                   kernelVec(in.sw[j]), xi, in.clip, in.dt, out.f, out.nxft, vir, overlap);
+    if constexpr (Tangential::kHasHistory) in.history[k] = storedVec(xi);
+    virial += vir;
+    overlapRatio = std::max(overlapRatio, overlap);
     return true;
 }
 
@@ -212,24 +282,211 @@ template <int D, class Normal, class Tangential, class Then>
     return {worst, contacts, std::isfinite(s)};
 }
 
+/// Whether the contact law runs on four touching pairs at once (core/lanes.hpp): with AVX2, whose gathers load
+/// the four pairs' data. Otherwise the pairs of a block are evaluated one by one. Same bits either way.
+#ifdef __AVX2__
+inline constexpr bool kLanePairs = true;
+#else
+inline constexpr bool kLanePairs = false;
+#endif
+
+/// A vector into a zero-padded row of PairBlock.
+template <int D>
+inline void storeRow(double* row, const KernelVec<D>& v) {
+#ifdef __AVX__
+    if constexpr (D == 3) {
+        _mm256_store_pd(row, v.l);
+        return;
+    }
+#endif
+    const Vec<D> a = storedVec(v);
+    for (int k = 0; k < 4; ++k) row[k] = k < D ? a[k] : 0.0;
+}
+
+/// The first N numbers of a row as a vector.
+template <int N>
+inline KernelVec<N> rowVec(const double* row) {
+#ifdef __AVX__
+    if constexpr (N == 3) return Wide3{_mm256_blend_pd(_mm256_load_pd(row), _mm256_setzero_pd(), 8)};
+#endif
+    Vec<N> a;
+    for (int k = 0; k < N; ++k) a[k] = row[k];
+    return kernelVec(a);
+}
+
+/// Pass (1) over the block's particles [b0, b1): the contact test of each listed pair, without a branch on its
+/// outcome: the pair is written at the end of the list of touching pairs, which grows by one when it touches; its
+/// spring moves from the pair list to the block (the list keeps a zero, right for a pair not touching). Cross
+/// pairs (kCross, partner >= e) come from their slots, cross[c...]. Returns the number of touching pairs.
+template <int D, class Tangential, bool kCross>
+[[gnu::noinline]] std::uint32_t findTouching(const PairInputs<D>& in, const std::uint32_t* first, std::size_t b0,
+                                             std::size_t b1, std::size_t e, const CrossPair<D>* cross,
+                                             std::size_t& c, PairBlock<D>& bl) {
+    using Block = PairBlock<D>;
+    const Vec<D>* x = in.x;
+    const double* radius = in.radius;
+    const std::uint16_t* material = in.material;
+    const std::uint32_t* partner = in.partner;
+    const std::uint8_t* shift = in.shift;
+    Vec<D>* history = in.history;
+    typename Block::Item* items = bl.items.data();
+    typename Block::Rows* rows = bl.rows.data();
+    std::uint32_t* entry = bl.entry.data();
+    std::uint32_t* outPartner = bl.outPartner.data();
+    std::uint32_t nl = 0, ne = 0, last = 0;
+    for (std::size_t i = b0; i < b1; ++i) {
+        const KernelVec<D> xi = kernelVec(x[i]);
+        const double ri = radius[i];
+        const std::uint32_t row = std::uint32_t{material[i]} * static_cast<std::uint32_t>(in.nMaterials);
+        for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
+            const std::uint32_t j = partner[k];
+            if constexpr (kCross) {
+                if (j >= e) {  // evaluated before, in its slot
+                    const CrossPair<D>& q = cross[c++];
+                    if (!q.touching) continue;
+                    typename Block::Entry& o = bl.out[ne];
+                    storeRow<D>(o.a.c, kernelVec(q.f));
+                    o.a.c[3] = q.virial;
+                    storeRow<kAngDim<D>>(o.b.c, kernelVec(q.nxft));
+                    o.b.c[3] = q.overlap;
+                    outPartner[ne++] = Block::kNoPartner;
+                    continue;
+                }
+            }
+            last = std::max(last, j);
+            KernelVec<D> d = xi - kernelVec(x[j]);
+            if (shift[k] != PairList<D>::kNoShift) d += kernelVec(in.shiftVec[shift[k]]);
+            const double rsum = ri + radius[j];
+            const double dist2 = norm2(d);
+            items[nl] = {static_cast<std::uint32_t>(i), j, k, row + material[j]};
+            storeRow<D>(rows[nl].sep.c, d);
+            if constexpr (Tangential::kHasHistory) {
+                storeRow<D>(rows[nl].spring.c, kernelVec(history[k]));
+                history[k] = Vec<D>::zero();
+            }
+            if constexpr (kCross) {
+                entry[nl] = ne;
+                outPartner[ne] = j;
+            }
+            const bool touching = !(dist2 >= rsum * rsum);  // a NaN counts as touching: it must be seen
+            nl += touching;
+            ne += touching;
+        }
+        bl.ownerEnd[i - b0] = ne;
+    }
+    bl.reach = std::max<std::size_t>(std::size_t{last} + 1, b1);
+    return nl;
+}
+
+/// Pass (2): the law on the block's touching pairs [0, nl) (nl a multiple of 4 when kLanes): their springs go
+/// back to the pair list, their contributions to the block's entries.
+template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
+[[gnu::noinline]] void evalTouching(const PairInputs<D>& in, PairBlock<D>& bl, std::uint32_t nl) {
+    using Row = typename PairBlock<D>::Row;
+    using Entry = typename PairBlock<D>::Entry;
+    constexpr int A = kAngDim<D>;
+    const typename PairBlock<D>::Item* items = bl.items.data();
+    const typename PairBlock<D>::Rows* rows = bl.rows.data();
+    const std::uint32_t* entry = bl.entry.data();
+    Entry* out = bl.out.data();
+    Vec<D>* history = in.history;
+    for (std::uint32_t m = 0; m < nl; m += kLanes ? 4 : 1) {
+        if constexpr (kLanes) {
+            const auto* it = items + m;
+            const LaneIndex ii = {std::int32_t(it[0].owner), std::int32_t(it[1].owner), std::int32_t(it[2].owner),
+                                  std::int32_t(it[3].owner)};
+            const LaneIndex jj = {std::int32_t(it[0].partner), std::int32_t(it[1].partner),
+                                  std::int32_t(it[2].partner), std::int32_t(it[3].partner)};
+            const LaneIndex cc = {std::int32_t(it[0].coeff), std::int32_t(it[1].coeff), std::int32_t(it[2].coeff),
+                                  std::int32_t(it[3].coeff)};
+            const auto* rw = rows + m;
+            Lanes t[4];
+            transpose4(rw[0].sep.c, rw[1].sep.c, rw[2].sep.c, rw[3].sep.c, t);
+            LaneVec<D> d;
+            for (int k = 0; k < D; ++k) d.c[k] = t[k];
+            LaneVec<D> xi = LaneVec<D>::zero();
+            if constexpr (Tangential::kHasHistory) {
+                transpose4(rw[0].spring.c, rw[1].spring.c, rw[2].spring.c, rw[3].spring.c, t);
+                for (int k = 0; k < D; ++k) xi.c[k] = t[k];
+            }
+            const LanePairCoeffs c(in.table, cc);
+            LaneVec<D> f;
+            LaneVec<A> nxft;
+            Lanes vir, overlap;
+            contactLaw<Normal, Tangential>(c, d, norm2(d), gather(in.radius, ii), gather(in.radius, jj),
+                                           gather(in.invMass, ii), gather(in.invMass, jj), gather(in.v, ii),
+                                           gather(in.v, jj), gather(in.w, ii), gather(in.w, jj), gather(in.sv, ii),
+                                           gather(in.sv, jj), gather(in.sw, ii), gather(in.sw, jj), xi, in.clip,
+                                           in.dt, f, nxft, vir, overlap);
+            // Back to rows, one per pair: the spring, then the entry.
+            const Lanes zero(0.0);
+            Row r[4];
+            if constexpr (Tangential::kHasHistory) {
+                const Lanes h[4] = {xi.c[0], laneOr0(xi, 1), laneOr0(xi, 2), zero};
+                transpose4(h, r[0].c, r[1].c, r[2].c, r[3].c);
+                for (int l = 0; l < 4; ++l) {
+                    Vec<D> hv;
+                    for (int k = 0; k < D; ++k) hv[k] = r[l].c[k];
+                    history[it[l].slot] = hv;
+                }
+            }
+            Entry* o[4];
+            for (int l = 0; l < 4; ++l) o[l] = out + (kCross ? entry[m + l] : m + l);
+            const Lanes fa[4] = {f.c[0], laneOr0(f, 1), laneOr0(f, 2), vir};
+            transpose4(fa, o[0]->a.c, o[1]->a.c, o[2]->a.c, o[3]->a.c);
+            const Lanes nb[4] = {nxft.c[0], laneOr0(nxft, 1), laneOr0(nxft, 2), overlap};
+            transpose4(nb, o[0]->b.c, o[1]->b.c, o[2]->b.c, o[3]->b.c);
+        } else {
+            using V = KernelVec<D>;
+            const std::uint32_t i = items[m].owner, j = items[m].partner;
+            const V d = rowVec<D>(rows[m].sep.c);
+            V xi = V::zero();
+            if constexpr (Tangential::kHasHistory) xi = rowVec<D>(rows[m].spring.c);
+            V f;
+            KernelVec<A> nxft;
+            double vir, overlap;
+            contactLaw<Normal, Tangential>(in.table[items[m].coeff], d, norm2(d), in.radius[i], in.radius[j],
+                                           in.invMass[i], in.invMass[j], kernelVec(in.v[i]), kernelVec(in.v[j]),
+                                           kernelVec(in.w[i]), kernelVec(in.w[j]), kernelVec(in.sv[i]),
+                                           kernelVec(in.sv[j]), kernelVec(in.sw[i]), kernelVec(in.sw[j]), xi,
+                                           in.clip, in.dt, f, nxft, vir, overlap);
+            if constexpr (Tangential::kHasHistory) history[items[m].slot] = storedVec(xi);
+            Entry& o = out[kCross ? entry[m] : m];
+            storeRow<D>(o.a.c, f);
+            o.a.c[3] = vir;
+            storeRow<A>(o.b.c, nxft);
+            o.b.c[3] = overlap;
+        }
+    }
+}
+
 /// The pass over particles [b, e), which holds every partner of their pairs except the cross pairs (kCross:
 /// partner >= e), evaluated before into cross[c0...] in pair order; crossIn: the cross pairs whose partner is in
 /// [b, e), by partner then pair. Per-particle virial sums go to virial[i] when a thread split needs them kept
 /// apart, else into *virialSum (in particle order either way).
-template <int D, class Normal, class Tangential, bool kCross, class Then>
+///
+/// The particles go in blocks of a few dozen, each in three passes: (1) the contact tests, without a branch on
+/// their outcome (findTouching); (2) the contact law on the touching pairs, four at a time in lanes (evalTouching),
+/// where their long chains of square roots and divisions overlap instead of waiting one behind the other; (3) in
+/// pair order, as when each pair was evaluated as its owner came, each contribution added to its owner and
+/// subtracted from its partner, and each particle finished. The law reads positions and velocities only, which no
+/// particle of the block or after it has had changed yet (finishing changes a particle's velocity, after its last
+/// pair), so the passes give the same bits as one pair at a time.
+template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class Then>
 [[gnu::always_inline]] inline RangeTally forceRange(Particles<D>& p, const PairInputs<D>& in,
                                                      const std::uint32_t* first, const Wall<D>* walls, std::size_t nw,
                                                      Vec<D>* wh, const ContactSetup& cs, double time, const Vec<D>& g,
                                                      std::size_t b, std::size_t e, const CrossPair<D>* cross,
                                                      std::size_t c0, const std::uint64_t* crossIn,
                                                      const std::uint64_t* crossInEnd, double* virial,
-                                                     double* virialSum, Then& then) {
+                                                     double* virialSum, PairBlock<D>& bl, Then& then) {
+    using Block = PairBlock<D>;
     Vec<D>* f = p.f.data();
     Ang<D>* nx = p.torque.data();  // holds the sums of n x F_t until the particle is finished
     const double* mass = p.mass.data();
-    // A particle's sums start (gravity, then the cross pairs where it is the partner) just before the first pair
-    // that adds to them: particles [b, done) have started. Each row is sorted by partner, so its last pair reaches
-    // farthest; starting the sums there, not in a pass of their own, keeps them in cache until they are used.
+    // A particle's sums start (gravity, then the cross pairs where it is the partner) just before the first block
+    // whose pairs add to them: particles [b, done) have started. Starting the sums there, not in a pass of their
+    // own, keeps them in cache until they are used.
     std::size_t done = b;
     const std::uint64_t* q = crossIn;
     auto startUpTo = [&](std::size_t end) {
@@ -248,48 +505,63 @@ template <int D, class Normal, class Tangential, bool kCross, class Then>
     };
     RangeTally st;
     std::size_t c = c0;
-    for (std::size_t i = b; i < e; ++i) {
-        const std::uint32_t k0 = first[i], k1 = first[i + 1];
-        std::size_t reach = k1 > k0 ? std::size_t{in.partner[k1 - 1]} + 1 : i + 1;
-        if constexpr (kCross) reach = std::min(reach, e);
-        startUpTo(std::max(reach, i + 1));
-        const Owner<D> a(in, i);
-        KernelVec<D> fi = kernelVec(f[i]);
-        KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
-        double worst = 0, vir = 0;
-        std::uint32_t nc = 0;
-        for (std::uint32_t k = k0; k < k1; ++k) {
-            const std::uint32_t j = in.partner[k];
-            if constexpr (kCross) {
-                if (j >= e) {
-                    const CrossPair<D>& x = cross[c++];
-                    if (!x.touching) continue;
-                    fi += kernelVec(x.f);
-                    nxi += kernelVec(x.nxft);
-                    vir += x.virial;
-                    worst = std::max(worst, x.overlap);
-                    ++nc;
-                    continue;
+    for (std::size_t b0 = b, b1; b0 < e; b0 = b1) {
+        b1 = b0 + 1;
+        while (b1 < e && b1 - b0 < Block::kOwners && first[b1 + 1] - first[b0] <= Block::kPairs) ++b1;
+        bl.fit(first[b1] - first[b0]);
+        const std::uint32_t nl = findTouching<D, Tangential, kCross>(in, first, b0, b1, e, cross, c, bl);
+        if (nl > 0) {
+            std::uint32_t padded = nl;
+            if constexpr (kLanes) {
+                // The last lanes repeat the last pair: the same result, written twice to the same places.
+                for (; padded % 4 != 0; ++padded) {
+                    const std::uint32_t s = nl - 1;
+                    bl.items[padded] = bl.items[s];
+                    bl.rows[padded] = bl.rows[s];
+                    bl.entry[padded] = bl.entry[s];
                 }
             }
-            PairForce<D> pf;
-            if (!evalPair<D, Normal, Tangential>(in, a, k, pf, worst, vir)) continue;
-            fi += pf.f;
-            nxi += pf.nxft;
-            f[j] = storedVec(kernelVec(f[j]) - pf.f);
-            nx[j] = storedVec(kernelVec(nx[j]) + pf.nxft);
-            ++nc;
+            evalTouching<D, Normal, Tangential, kCross, kLanes>(in, bl, padded);
         }
-        const ParticleTally t = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, a,
-                                                                      storedVec(fi), storedVec(nxi), worst, nc, then);
-        st.contacts += t.contacts;
-        if constexpr (kCross) virial[i] = vir;
-        else *virialSum += vir;
-        if (t.worst > st.maxOverlapRatio) {
-            st.maxOverlapRatio = t.worst;
-            st.worstParticle = i;
+        // (3) The sums, in pair order, and each particle finished.
+        const typename Block::Entry* out = bl.out.data();
+        const std::uint32_t* outPartner = bl.outPartner.data();
+        const typename Block::Item* items = bl.items.data();
+        // Every particle that the block's pairs add to starts here, once for the block.
+        startUpTo(bl.reach);
+        std::uint32_t t = 0;
+        for (std::size_t i = b0; i < b1; ++i) {
+            const Owner<D> a(in, i);
+            KernelVec<D> fi = kernelVec(f[i]);
+            KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
+            double worst = 0, vir = 0;
+            std::uint32_t nc = 0;
+            for (const std::uint32_t tEnd = bl.ownerEnd[i - b0]; t < tEnd; ++t) {
+                const typename Block::Entry& x = out[t];
+                const KernelVec<D> pf = rowVec<D>(x.a.c);
+                const KernelVec<kAngDim<D>> pn = rowVec<kAngDim<D>>(x.b.c);
+                fi += pf;
+                nxi += pn;
+                const std::uint32_t j = kCross ? outPartner[t] : items[t].partner;
+                if (!kCross || j != Block::kNoPartner) {
+                    f[j] = storedVec(kernelVec(f[j]) - pf);
+                    nx[j] = storedVec(kernelVec(nx[j]) + pn);
+                }
+                vir += x.a.c[3];
+                worst = std::max(worst, x.b.c[3]);
+                ++nc;
+            }
+            const ParticleTally pt = finishParticle<D, Normal, Tangential>(
+                p, in, walls, nw, wh, cs, time, i, a, storedVec(fi), storedVec(nxi), worst, nc, then);
+            st.contacts += pt.contacts;
+            if constexpr (kCross) virial[i] = vir;
+            else *virialSum += vir;
+            if (pt.worst > st.maxOverlapRatio) {
+                st.maxOverlapRatio = pt.worst;
+                st.worstParticle = i;
+            }
+            if (!pt.finite && st.nonFinite == ForceStats::kNone) st.nonFinite = i;
         }
-        if (!t.finite && st.nonFinite == ForceStats::kNone) st.nonFinite = i;
     }
     return st;
 }
@@ -297,8 +569,9 @@ template <int D, class Normal, class Tangential, bool kCross, class Then>
 /// Forces at the predicted state. sv/sw: mean velocities over the last step (StepMotion), which increment
 /// the tangential springs; the damping terms use the predicted velocities p.v, p.w. then(i) runs once particle
 /// i's force and torque are final, with them: then(i, f, torque) (it may change i's velocities, not its position;
-/// nothing reads them after).
-template <int D, class Normal, class Tangential, class Then>
+/// nothing reads them after). kLanes: the law on four pairs at once (kLanePairs) or one by one, for tests that
+/// hold the two to the same bits.
+template <int D, class Normal, class Tangential, bool kLanes = kLanePairs, class Then>
 ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wall<D>>& walls,
                          std::vector<Vec<D>>& wallHistory, const ContactSetup& cs, const Domain<D>& dom,
                          double time, double dt, const Vec<D>* sv, const Ang<D>* sw, ForceScratch<D>& s,
@@ -316,10 +589,11 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
     const int nt = n >= kParallelMin ? omp_get_max_threads() : 1;
     ForceStats st;
 
+    if (s.blocks.size() < static_cast<std::size_t>(nt)) s.blocks.resize(static_cast<std::size_t>(nt));
     if (nt <= 1) {
-        const RangeTally t = forceRange<D, Normal, Tangential, false>(p, in, first, wp, nw, wh, cs, time, g, 0, n,
-                                                                      nullptr, 0, nullptr, nullptr, nullptr,
-                                                                      &st.virial, then);
+        const RangeTally t = forceRange<D, Normal, Tangential, false, kLanes>(p, in, first, wp, nw, wh, cs, time,
+                                                                              g, 0, n, nullptr, 0, nullptr, nullptr,
+                                                                              nullptr, &st.virial, s.blocks[0], then);
         st.contacts = t.contacts;
         st.maxOverlapRatio = t.maxOverlapRatio;
         st.worstParticle = t.worstParticle;
@@ -354,9 +628,10 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
 #pragma omp for schedule(static, 1)
         for (int r = 0; r < nt; ++r) {
             const std::uint64_t* ci = sp.crossIn.data();
-            tally[r] = forceRange<D, Normal, Tangential, true>(
+            tally[r] = forceRange<D, Normal, Tangential, true, kLanes>(
                 p, in, first, wp, nw, wh, cs, time, g, sp.start[r], sp.start[r + 1], cross, sp.crossFirst[r],
-                ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1], s.virial.data(), nullptr, then);
+                ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1], s.virial.data(), nullptr,
+                s.blocks[static_cast<std::size_t>(r)], then);
         }
     }
     // The one-thread reductions, in the same order.

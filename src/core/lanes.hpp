@@ -1,0 +1,204 @@
+#pragma once
+// Four doubles side by side, one per contact, for the force loop's contact law on four touching pairs at once
+// (tdm/forces.hpp). Lane by lane the arithmetic is that of double in the same order, with the same correctly
+// rounded operations (+ - * / and the square root; no fused multiply-add under -ffp-contract=off), so a contact
+// evaluated in a lane gives the bits it gives alone. A branch of the scalar law becomes select(): both sides are
+// computed and each lane keeps its own, which is the value its branch would have given.
+//
+// The contact law is written once for both (contact/laws.hpp): its scalar type S is double or Lanes, its vectors
+// Vec<N> (or Wide3) or LaneVec<N>, and it uses the helpers below that have a version for each: sqrtOf, select,
+// anyOf, minOf.
+//
+// With AVX a Lanes is one register; without it GCC splits the same code into pairs of SSE operations.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#ifdef __AVX__
+#include <immintrin.h>
+#endif
+
+#include "core/vec.hpp"
+
+namespace haet {
+
+/// The result of comparing Lanes: all bits set in a lane where the comparison holds.
+struct LaneMask {
+    using Bits = long long __attribute__((vector_size(32)));
+    Bits m;
+    friend LaneMask operator&(LaneMask a, LaneMask b) { return {a.m & b.m}; }
+    friend LaneMask operator|(LaneMask a, LaneMask b) { return {a.m | b.m}; }
+};
+
+struct Lanes {
+    using Values = double __attribute__((vector_size(32)));
+    Values v;
+
+    Lanes() = default;
+    Lanes(double s) : v{s, s, s, s} {}  // NOLINT: a constant of the law, the same in every lane
+    explicit Lanes(Values x) : v(x) {}
+
+    Lanes& operator+=(Lanes o) { v += o.v; return *this; }
+    Lanes& operator-=(Lanes o) { v -= o.v; return *this; }
+    Lanes& operator*=(Lanes o) { v *= o.v; return *this; }
+    friend Lanes operator+(Lanes a, Lanes b) { return Lanes(a.v + b.v); }
+    friend Lanes operator-(Lanes a, Lanes b) { return Lanes(a.v - b.v); }
+    friend Lanes operator*(Lanes a, Lanes b) { return Lanes(a.v * b.v); }
+    friend Lanes operator/(Lanes a, Lanes b) { return Lanes(a.v / b.v); }
+    friend Lanes operator-(Lanes a) { return Lanes(-a.v); }
+    friend LaneMask operator<(Lanes a, Lanes b) { return {a.v < b.v}; }
+    friend LaneMask operator>(Lanes a, Lanes b) { return {a.v > b.v}; }
+    double operator[](int l) const { return v[l]; }
+};
+
+// The helpers, for double and for Lanes.
+inline double sqrtOf(double x) { return std::sqrt(x); }
+inline Lanes sqrtOf(Lanes x) {
+#ifdef __AVX__
+    return Lanes(_mm256_sqrt_pd(x.v));
+#else
+    return Lanes(Lanes::Values{std::sqrt(x.v[0]), std::sqrt(x.v[1]), std::sqrt(x.v[2]), std::sqrt(x.v[3])});
+#endif
+}
+/// m ? a : b, lane by lane.
+template <class T>
+inline T select(bool m, const T& a, const T& b) { return m ? a : b; }
+inline Lanes select(LaneMask m, Lanes a, Lanes b) { return Lanes(m.m ? a.v : b.v); }
+/// Whether the condition holds in some lane: the law skips work no lane needs.
+inline bool anyOf(bool m) { return m; }
+inline bool anyOf(LaneMask m) {
+#ifdef __AVX__
+    return _mm256_movemask_pd(reinterpret_cast<__m256d>(m.m)) != 0;
+#else
+    return (m.m[0] | m.m[1] | m.m[2] | m.m[3]) != 0;
+#endif
+}
+/// std::min(a, b) = (b < a) ? b : a, lane by lane.
+inline double minOf(double a, double b) { return std::min(a, b); }
+inline Lanes minOf(Lanes a, Lanes b) { return select(b < a, b, a); }
+/// std::max(a, b) = (a < b) ? b : a, lane by lane.
+inline double maxOf(double a, double b) { return std::max(a, b); }
+inline Lanes maxOf(Lanes a, Lanes b) { return select(a < b, b, a); }
+
+/// N-vectors of four contacts: component c of lane l is c[c][l]. The operations are those of Vec<N>, in the
+/// same order.
+template <int N>
+struct LaneVec {
+    std::array<Lanes, N> c;
+
+    static LaneVec zero() {
+        LaneVec r;
+        for (int k = 0; k < N; ++k) r.c[k] = Lanes(0.0);
+        return r;
+    }
+    Lanes& operator[](int k) { return c[k]; }
+    Lanes operator[](int k) const { return c[k]; }
+    LaneVec& operator+=(const LaneVec& o) {
+        for (int k = 0; k < N; ++k) c[k] += o.c[k];
+        return *this;
+    }
+    LaneVec& operator-=(const LaneVec& o) {
+        for (int k = 0; k < N; ++k) c[k] -= o.c[k];
+        return *this;
+    }
+    LaneVec& operator*=(Lanes s) {
+        for (int k = 0; k < N; ++k) c[k] *= s;
+        return *this;
+    }
+    friend LaneVec operator+(LaneVec a, const LaneVec& b) { return a += b; }
+    friend LaneVec operator-(LaneVec a, const LaneVec& b) { return a -= b; }
+    friend LaneVec operator*(LaneVec a, Lanes s) { return a *= s; }
+    /// Lane l as a Vec<N>.
+    Vec<N> lane(int l) const {
+        Vec<N> r;
+        for (int k = 0; k < N; ++k) r[k] = c[k][l];
+        return r;
+    }
+};
+
+/// Component k, or zeros past the last.
+template <int N>
+inline Lanes laneOr0(const LaneVec<N>& a, int k) { return k < N ? a.c[k] : Lanes(0.0); }
+
+template <int N>
+inline Lanes dot(const LaneVec<N>& a, const LaneVec<N>& b) {
+    Lanes s = a[0] * b[0];
+    for (int k = 1; k < N; ++k) s += a[k] * b[k];
+    return s;
+}
+template <int N>
+inline Lanes norm2(const LaneVec<N>& a) { return dot(a, a); }
+inline LaneVec<2> cross(const LaneVec<1>& w, const LaneVec<2>& r) { return {{-w[0] * r[1], w[0] * r[0]}}; }
+inline LaneVec<3> cross(const LaneVec<3>& a, const LaneVec<3>& b) {
+    return {{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
+}
+inline LaneVec<1> cross(const LaneVec<2>& r, const LaneVec<2>& f) { return {{r[0] * f[1] - r[1] * f[0]}}; }
+template <int N>
+inline LaneVec<N> select(LaneMask m, const LaneVec<N>& a, const LaneVec<N>& b) {
+    LaneVec<N> r;
+    for (int k = 0; k < N; ++k) r.c[k] = select(m, a.c[k], b.c[k]);
+    return r;
+}
+
+/// Four element indices (int32, as the AVX2 gathers take them).
+using LaneIndex = std::int32_t __attribute__((vector_size(16)));
+
+inline LaneIndex loadIndex(const std::uint32_t* p) {
+    LaneIndex r;
+    __builtin_memcpy(&r, p, sizeof r);
+    return r;
+}
+
+/// base[idx[l]] in lane l.
+inline Lanes gather(const double* base, LaneIndex idx) {
+#ifdef __AVX2__
+    // The masked form with a zero source: the plain one leaves GCC warning about its undefined source.
+    const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+    return Lanes(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), base, reinterpret_cast<__m128i>(idx), all, 8));
+#else
+    return Lanes(Lanes::Values{base[idx[0]], base[idx[1]], base[idx[2]], base[idx[3]]});
+#endif
+}
+
+/// a[idx[l]] in lane l.
+template <int N>
+inline LaneVec<N> gather(const Vec<N>* a, LaneIndex idx) {
+    const double* base = a[0].c.data();
+    const LaneIndex at = idx * N;
+    LaneVec<N> r;
+    for (int k = 0; k < N; ++k) r.c[k] = gather(base + k, at);
+    return r;
+}
+
+/// Rows r0..r3 of four doubles each, transposed: lane l of out[c] is row l's element c.
+inline void transpose4(const double* r0, const double* r1, const double* r2, const double* r3, Lanes out[4]) {
+#ifdef __AVX__
+    const __m256d a = _mm256_load_pd(r0), b = _mm256_load_pd(r1), c = _mm256_load_pd(r2),
+                  d = _mm256_load_pd(r3);
+    const __m256d ab0 = _mm256_unpacklo_pd(a, b), ab1 = _mm256_unpackhi_pd(a, b);  // a0 b0 a2 b2 | a1 b1 a3 b3
+    const __m256d cd0 = _mm256_unpacklo_pd(c, d), cd1 = _mm256_unpackhi_pd(c, d);
+    out[0] = Lanes(_mm256_permute2f128_pd(ab0, cd0, 0x20));
+    out[1] = Lanes(_mm256_permute2f128_pd(ab1, cd1, 0x20));
+    out[2] = Lanes(_mm256_permute2f128_pd(ab0, cd0, 0x31));
+    out[3] = Lanes(_mm256_permute2f128_pd(ab1, cd1, 0x31));
+#else
+    for (int k = 0; k < 4; ++k) out[k] = Lanes(Lanes::Values{r0[k], r1[k], r2[k], r3[k]});
+#endif
+}
+
+/// The other way: lane l of in[0..3] into row l (32-byte aligned).
+inline void transpose4(const Lanes in[4], double* r0, double* r1, double* r2, double* r3) {
+#ifdef __AVX__
+    const __m256d ab0 = _mm256_unpacklo_pd(in[0].v, in[1].v), ab1 = _mm256_unpackhi_pd(in[0].v, in[1].v);
+    const __m256d cd0 = _mm256_unpacklo_pd(in[2].v, in[3].v), cd1 = _mm256_unpackhi_pd(in[2].v, in[3].v);
+    _mm256_store_pd(r0, _mm256_permute2f128_pd(ab0, cd0, 0x20));
+    _mm256_store_pd(r1, _mm256_permute2f128_pd(ab1, cd1, 0x20));
+    _mm256_store_pd(r2, _mm256_permute2f128_pd(ab0, cd0, 0x31));
+    _mm256_store_pd(r3, _mm256_permute2f128_pd(ab1, cd1, 0x31));
+#else
+    double* r[4] = {r0, r1, r2, r3};
+    for (int l = 0; l < 4; ++l)
+        for (int k = 0; k < 4; ++k) r[l][k] = in[k][l];
+#endif
+}
+
+}  // namespace haet

@@ -1,0 +1,126 @@
+// The force loop's contact law on four touching pairs at once in lanes (core/lanes.hpp) against the same loop
+// evaluating them one by one: the same forces, torques, springs and statistics to the last bit, for every normal
+// law, with one and two threads, in 2D and 3D. The scene is a hot frictional gas of two materials between walls
+// (tests/data/threads*.toml with a second material), stepped a while first so that contacts carry springs and
+// some slide.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "scenario/loader.hpp"
+#include "tdm/engine.hpp"
+#include "tdm/forces.hpp"
+#include "world/build.hpp"
+#include "scenario_text.hpp"
+
+namespace haet {
+namespace {
+
+using testing::replaced;
+
+template <class T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+/// threadsXd.toml with 500 fewer particles, and 500 of a second material (other friction and restitution, other sizes).
+Scenario twoMaterialGas(const char* name) {
+    const std::filesystem::path file = std::filesystem::path(HAET_SOURCE_DIR) / "tests" / "data" / name;
+    std::ifstream in(file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::string text = replaced(ss.str(), "[contact]", R"([materials.rubber]
+density = 1200
+restitution = 0.6
+friction = 0.9
+
+[contact])");
+    text = replaced(text, "count = 3000", "count = 2500");
+    text += R"(
+[[insert]]
+arrangement = "random"
+count = 500
+radius = [0.0008, 0.0012]
+material = "rubber"
+temperature = 0.1
+)";
+    return parseScenario(text, file);
+}
+
+template <int D, class Normal>
+void expectLanesMatchOneByOne(const Scenario& sc, int threads) {
+    World<D> w = buildWorld<D>(sc);
+    ASSERT_EQ(w.contact.nMaterials, 2);
+    TdmEngine<D> eng(w, tdmSettings<D>(sc, w));
+    for (int k = 0; k < 300; ++k) eng.step();
+    ContactSetup cs = w.contact;
+    // The Hertz laws get coefficients of their own (the scene's are linear), different per material pair.
+    for (std::size_t m = 0; m < cs.table.size(); ++m) {
+        cs.table[m].hertzK = 2e8 * (1.0 + 0.5 * double(m));
+        cs.table[m].dissipationTime = 1e-6 * (1.0 + double(m));
+        cs.table[m].tsujiAlpha = 0.2 + 0.1 * double(m);
+    }
+    const int before = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    auto run = [&](auto lanes, Particles<D>& p, PairList<D>& pl, std::vector<Vec<D>>& wh) {
+        p = w.particles;
+        pl = eng.pairs();
+        wh.assign(p.tdmCount() * w.walls.size(), Vec<D>::zero());
+        // Walls carry springs too: a first evaluation makes them, the second is compared.
+        ForceScratch<D> s;
+        auto none = [](std::size_t, const Vec<D>&, const Ang<D>&) {};
+        computeForces<D, Normal, SpringTangential, decltype(lanes)::value>(
+            p, pl, w.walls, wh, cs, w.domain, w.time, 1e-6, w.particles.v.data(), w.particles.w.data(), s, none);
+        return computeForces<D, Normal, SpringTangential, decltype(lanes)::value>(
+            p, pl, w.walls, wh, cs, w.domain, w.time, 1e-6, w.particles.v.data(), w.particles.w.data(), s, none);
+    };
+    Particles<D> pa, pb;
+    PairList<D> la, lb;
+    std::vector<Vec<D>> wa, wb;
+    const ForceStats a = run(std::true_type{}, pa, la, wa);
+    const ForceStats b = run(std::false_type{}, pb, lb, wb);
+    omp_set_num_threads(before);
+    EXPECT_GT(a.contacts, 40u) << "few contacts: the test would prove little";
+    EXPECT_EQ(a.contacts, b.contacts);
+    EXPECT_EQ(std::memcmp(&a.virial, &b.virial, sizeof(double)), 0) << a.virial << " " << b.virial;
+    EXPECT_EQ(std::memcmp(&a.maxOverlapRatio, &b.maxOverlapRatio, sizeof(double)), 0);
+    EXPECT_EQ(a.worstParticle, b.worstParticle);
+    EXPECT_EQ(a.nonFinite, b.nonFinite);
+    EXPECT_TRUE(sameBits(pa.f, pb.f));
+    EXPECT_TRUE(sameBits(pa.torque, pb.torque));
+    EXPECT_TRUE(sameBits(la.history, lb.history));
+    EXPECT_TRUE(sameBits(wa, wb));
+    // The touching pairs carry springs (their law ran, not only the contact test).
+    std::size_t springs = 0;
+    for (const Vec<D>& h : la.history) springs += norm2(h) > 0;
+    EXPECT_GT(springs, 40u);
+}
+
+TEST(ForceLanes, LinearSameBitsAsOneByOne3D) {
+    const Scenario sc = twoMaterialGas("threads3d.toml");
+    expectLanesMatchOneByOne<3, LinearNormal>(sc, 1);
+    expectLanesMatchOneByOne<3, LinearNormal>(sc, 2);
+}
+
+TEST(ForceLanes, LinearSameBitsAsOneByOne2D) {
+    const Scenario sc = twoMaterialGas("threads2d.toml");
+    expectLanesMatchOneByOne<2, LinearNormal>(sc, 1);
+    expectLanesMatchOneByOne<2, LinearNormal>(sc, 2);
+}
+
+TEST(ForceLanes, HertzSameBitsAsOneByOne) {
+    const Scenario s3 = twoMaterialGas("threads3d.toml");
+    expectLanesMatchOneByOne<3, HertzViscoNormal>(s3, 1);
+    expectLanesMatchOneByOne<3, HertzTsujiNormal>(s3, 2);
+    const Scenario s2 = twoMaterialGas("threads2d.toml");
+    expectLanesMatchOneByOne<2, HertzViscoNormal>(s2, 2);
+    expectLanesMatchOneByOne<2, HertzTsujiNormal>(s2, 1);
+}
+
+}  // namespace
+}  // namespace haet
