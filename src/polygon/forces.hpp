@@ -80,10 +80,36 @@ inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
     }
 }
 
+/// Overlap of a polygon and a disk, i and j at x_j + d and x_j (one of them a polygon). Frame: origin at x_j.
+/// Out of line: it keeps the vertex buffers out of the polygon pairs' stack frame.
+[[gnu::noinline]] inline Overlap polygonDiskOverlap(const Particles<2>& p, const PolygonScratch& ps, std::size_t i,
+                                                    std::uint32_t j, const V2& d) {
+    const ShapeTable& st = p.shapes;
+    const std::uint32_t si = p.shape[i], sj = p.shape[j];
+    VertexBuffer<kMaxVertices> P, Q;
+    if (si != kNoShape) {  // polygon i, disk j: the circle at the origin
+        const int np = st.count(si);
+        const V2* a = ps.rotated.data() + st.first[si];
+        for (int m = 0; m < np; ++m) P[m] = a[m] + d;
+        return circlePolygonOverlap(p.radius[j], P.data(), np);
+    }
+    // disk i, polygon j: overlap about x_i, then back to the frame of x_j, outline pieces of i
+    const int nq = st.count(sj);
+    const V2* b = ps.rotated.data() + st.first[sj];
+    for (int m = 0; m < nq; ++m) Q[m] = b[m] - d;
+    Overlap o = circlePolygonOverlap(p.radius[i], Q.data(), nq);
+    o.centroid += d;
+    o.chord = -o.chord;  // the circle's arcs inside j: minus j's outline inside the circle
+    o.spin = -o.spin;
+    return o;
+}
+
 /// Evaluates pair slot k of particle i (at least one of the two a polygon). Frame: origin at x_j.
-inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const ContactSetup& cs, const PolygonScratch& ps,
-                            const V2* sv, const Ang<2>* sw, double dt, std::size_t i, std::uint32_t k,
-                            PairResult& out, double& overlapRatio, double& virial) {
+/// Inlined into the pass: a call per pair cost as much as the rejection of a pair that does not touch.
+[[gnu::always_inline]] inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const ContactSetup& cs,
+                                                   const PolygonScratch& ps, const V2* sv, const Ang<2>* sw, double dt,
+                                                   std::size_t i, std::uint32_t k, PairResult& out,
+                                                   double& overlapRatio, double& virial) {
     const std::uint32_t j = pl.partner[k];
     const V2 d = p.x[i] - p.x[j] + pl.shiftVec[pl.shift[k]];
     const double ri = p.radius[i], rj = p.radius[j];
@@ -96,7 +122,6 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
     const std::uint32_t si = p.shape[i], sj = p.shape[j];
     const ShapeTable& st = p.shapes;
     Overlap o;
-    VertexBuffer<kMaxVertices> P, Q;
     if (si != kNoShape && sj != kNoShape) {
         const int np = st.count(si), nq = st.count(sj);
         const V2* a = ps.rotated.data() + st.first[si];
@@ -111,19 +136,8 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
             return false;
         }
         o = clipOverlap(a, np, b, nq, nullptr, &d, ri, &d);
-    } else if (si != kNoShape) {  // polygon i, disk j: the circle at the origin
-        const int np = st.count(si);
-        const V2* a = ps.rotated.data() + st.first[si];
-        for (int m = 0; m < np; ++m) P[m] = a[m] + d;
-        o = circlePolygonOverlap(rj, P.data(), np);
-    } else {  // disk i, polygon j: overlap about x_i, then back to the frame of x_j, outline pieces of i
-        const int nq = st.count(sj);
-        const V2* b = ps.rotated.data() + st.first[sj];
-        for (int m = 0; m < nq; ++m) Q[m] = b[m] - d;
-        o = circlePolygonOverlap(ri, Q.data(), nq);
-        o.centroid += d;
-        o.chord = -o.chord;  // the circle's arcs inside j: minus j's outline inside the circle
-        o.spin = -o.spin;
+    } else {
+        o = polygonDiskOverlap(p, ps, i, j, d);
     }
     if (!(o.area > 0)) {
         if (!(hist == V2::zero())) hist = V2::zero();
