@@ -8,7 +8,9 @@
 // go through polygonContact (polygon/contact.hpp). Walls: half-plane overlap for polygons, the disk law for disks.
 //
 // Summation order, hence thread-count independence, is that of tdm/forces.hpp: gravity, the pairs in which the
-// particle is the partner (increasing pair index), its own pairs, its walls.
+// particle is the partner (increasing pair index), its own pairs, its walls. So is the pass: one thread runs once
+// over the particles, each finished (walls, statistics) right after its own pairs; T threads evaluate the cross
+// pairs of PairList::split first, then run that pass over their ranges.
 #include <cmath>
 #include <vector>
 
@@ -21,18 +23,33 @@
 
 namespace haet::polygon {
 
-/// Per-step work arrays of the polygon loop.
+/// Result of one pair: force on i, torques on i and j.
+struct PairResult {
+    V2 f{};
+    double ti = 0, tj = 0;
+    double energy = 0;
+};
+
+/// A pair evaluated before the ranges run (threaded path): a cross pair of PairList::split.
+struct PolygonCrossPair {
+    PairResult r;
+    double virial = 0;   ///< r_ij . F_ij [N m]
+    double overlap = 0;  ///< overlap / smaller radius
+    bool touching = false;
+};
+
+/// Work arrays of the polygon loop, kept between steps so that no step allocates.
 struct PolygonScratch {
     std::vector<V2> rotated;        ///< vertices of every shape turned by its particle's angle (body -> world
                                     ///< without the translation) [m]
-    std::vector<double> torqueI;    ///< threaded path: torque on i of each pair [N m]
-    std::vector<double> torqueJ;    ///< threaded path: torque on j of each pair [N m]
+    std::vector<double> inradius;   ///< per shape: distance from the centroid to the nearest edge line [m]
     std::vector<double> pairEnergy; ///< estimated elastic energy of each pair [J] (contactEnergy)
     std::vector<double> wallEnergy; ///< per particle: estimated elastic energy of its wall contacts [J]
-    std::vector<double> torque;     ///< per particle: pair torques [N m]
-    std::vector<double> inradius;   ///< per shape: distance from the centroid to the nearest edge line [m]
+    V2 gravity{};                   ///< [m/s^2]
+    std::vector<PolygonCrossPair> cross;  ///< threaded path: the cross pairs (PairList::split)
+    std::vector<double> virial;     ///< threaded path, per particle: sum over own pairs of r_ij . F_ij [N m]
+    std::vector<RangeTally> tally;  ///< threaded path: per-range statistics
 };
-
 
 /// Particle i as a body of the contact law (BodyState::x left at zero: the caller sets the frame).
 inline BodyState bodyOf(const Particles<2>& p, const V2* sv, const Ang<2>* sw, std::size_t i) {
@@ -63,17 +80,36 @@ inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
     }
 }
 
-/// Result of one pair: force on i, torques on i and j.
-struct PairResult {
-    V2 f{};
-    double ti = 0, tj = 0;
-    double energy = 0;
-};
+/// Overlap of a polygon and a disk, i and j at x_j + d and x_j (one of them a polygon). Frame: origin at x_j.
+/// Out of line: it keeps the vertex buffers out of the polygon pairs' stack frame.
+[[gnu::noinline]] inline Overlap polygonDiskOverlap(const Particles<2>& p, const PolygonScratch& ps, std::size_t i,
+                                                    std::uint32_t j, const V2& d) {
+    const ShapeTable& st = p.shapes;
+    const std::uint32_t si = p.shape[i], sj = p.shape[j];
+    VertexBuffer<kMaxVertices> P, Q;
+    if (si != kNoShape) {  // polygon i, disk j: the circle at the origin
+        const int np = st.count(si);
+        const V2* a = ps.rotated.data() + st.first[si];
+        for (int m = 0; m < np; ++m) P[m] = a[m] + d;
+        return circlePolygonOverlap(p.radius[j], P.data(), np);
+    }
+    // disk i, polygon j: overlap about x_i, then back to the frame of x_j, outline pieces of i
+    const int nq = st.count(sj);
+    const V2* b = ps.rotated.data() + st.first[sj];
+    for (int m = 0; m < nq; ++m) Q[m] = b[m] - d;
+    Overlap o = circlePolygonOverlap(p.radius[i], Q.data(), nq);
+    o.centroid += d;
+    o.chord = -o.chord;  // the circle's arcs inside j: minus j's outline inside the circle
+    o.spin = -o.spin;
+    return o;
+}
 
 /// Evaluates pair slot k of particle i (at least one of the two a polygon). Frame: origin at x_j.
-inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const ContactSetup& cs, const PolygonScratch& ps,
-                            const V2* sv, const Ang<2>* sw, double dt, std::size_t i, std::uint32_t k,
-                            PairResult& out, double& overlapRatio, double& virial) {
+/// Inlined into the pass: a call per pair cost as much as the rejection of a pair that does not touch.
+[[gnu::always_inline]] inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const ContactSetup& cs,
+                                                   const PolygonScratch& ps, const V2* sv, const Ang<2>* sw, double dt,
+                                                   std::size_t i, std::uint32_t k, PairResult& out,
+                                                   double& overlapRatio, double& virial) {
     const std::uint32_t j = pl.partner[k];
     const V2 d = p.x[i] - p.x[j] + pl.shiftVec[pl.shift[k]];
     const double ri = p.radius[i], rj = p.radius[j];
@@ -86,7 +122,6 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
     const std::uint32_t si = p.shape[i], sj = p.shape[j];
     const ShapeTable& st = p.shapes;
     Overlap o;
-    VertexBuffer<kMaxVertices> P, Q;
     if (si != kNoShape && sj != kNoShape) {
         const int np = st.count(si), nq = st.count(sj);
         const V2* a = ps.rotated.data() + st.first[si];
@@ -101,19 +136,8 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
             return false;
         }
         o = clipOverlap(a, np, b, nq, nullptr, &d, ri, &d);
-    } else if (si != kNoShape) {  // polygon i, disk j: the circle at the origin
-        const int np = st.count(si);
-        const V2* a = ps.rotated.data() + st.first[si];
-        for (int m = 0; m < np; ++m) P[m] = a[m] + d;
-        o = circlePolygonOverlap(rj, P.data(), np);
-    } else {  // disk i, polygon j: overlap about x_i, then back to the frame of x_j, outline pieces of i
-        const int nq = st.count(sj);
-        const V2* b = ps.rotated.data() + st.first[sj];
-        for (int m = 0; m < nq; ++m) Q[m] = b[m] - d;
-        o = circlePolygonOverlap(ri, Q.data(), nq);
-        o.centroid += d;
-        o.chord = -o.chord;  // the circle's arcs inside j: minus j's outline inside the circle
-        o.spin = -o.spin;
+    } else {
+        o = polygonDiskOverlap(p, ps, i, j, d);
     }
     if (!(o.area > 0)) {
         if (!(hist == V2::zero())) hist = V2::zero();
@@ -138,121 +162,82 @@ inline bool evalPolygonPair(const Particles<2>& p, PairList<2>& pl, const Contac
     return true;
 }
 
-/// Forces and torques of a 2D scene with polygons, at the predicted state (see tdm/forces.hpp for sv, sw).
-template <class Normal, class Tangential>
-ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vector<Wall<2>>& walls,
-                                std::vector<V2>& wallHistory, const ContactSetup& cs, const Domain<2>& dom,
-                                double time, double dt, const V2* sv, const Ang<2>* sw, ForceScratch<2>& s,
-                                PolygonScratch& ps) {
-    const std::size_t n = p.tdmCount();
-    const std::size_t np = pl.size();
-    rotateShapes(p, ps);
-    s.maxOverlap.resize(n);  // these three are written for every particle below
-    s.contacts.resize(n);
-    s.virial.resize(n);
-    ps.wallEnergy.assign(n, 0.0);
-    ps.pairEnergy.assign(np, 0.0);
-    std::vector<double>& torque = ps.torque;
-    torque.assign(n, 0.0);
-    const bool clip = !cs.attraction;
-    const int nm = cs.nMaterials;
-    const PairCoeffs* table = cs.table.data();
-    const V2 g = dom.gravity;
-    const bool threaded = n >= kParallelMin && omp_get_max_threads() > 1;
-
-    // One pair, whichever its kind: force on i and the torques on i and j.
-    const PairInputs<2> in{p.x.data(),        p.v.data(),      p.w.data(),         p.radius.data(),
-                           p.invMass.data(),  p.material.data(), sv,               sw,
-                           pl.partner.data(), pl.shift.data(), pl.shiftVec.data(), pl.history.data(),
-                           table,             nm,              clip,               dt};
-    auto pair = [&](std::size_t i, std::uint32_t k, PairResult& r, double& worst, double& vir) {
-        const std::uint32_t j = pl.partner[k];
-        if (p.shape[i] == kNoShape && p.shape[j] == kNoShape) {
-            PairForce<2> pf;
-            if (!evalPair<2, Normal, Tangential>(in, Owner<2>(in, i), k, pf, worst, vir)) return false;
-            r.f = pf.f;
-            r.ti = -p.radius[i] * pf.nxft[0];
-            r.tj = -p.radius[j] * pf.nxft[0];
-            r.energy = 0;  // disk pairs: TdmEngine::contactEnergy adds them from the overlaps
-            return true;
-        }
-        return evalPolygonPair(p, pl, cs, ps, sv, sw, dt, i, k, r, worst, vir);
-    };
-
-    if (!threaded) {
-        for (std::size_t i = 0; i < n; ++i) p.f[i] = g * p.mass[i];
-        for (std::size_t i = 0; i < n; ++i) {
-            double worst = 0, vir = 0;
-            std::uint32_t nc = 0;
-            for (std::uint32_t k = pl.first[i]; k < pl.first[i + 1]; ++k) {
-                PairResult r;
-                if (!pair(i, k, r, worst, vir)) continue;
-                const std::uint32_t j = pl.partner[k];
-                p.f[i] += r.f;
-                torque[i] += r.ti;
-                p.f[j] -= r.f;
-                torque[j] += r.tj;
-                ps.pairEnergy[k] = r.energy;
-                ++nc;
-            }
-            s.maxOverlap[i] = worst;
-            s.contacts[i] = nc;
-            s.virial[i] = vir;
-        }
-    } else {
-        if (pl.firstT.size() != n + 1) buildTransposedIndex(pl);  // built on first use after a list build
-        s.pairForce.resize(np);
-        ps.torqueI.resize(np);
-        ps.torqueJ.resize(np);
-#pragma omp parallel for schedule(dynamic, 256)
-        for (std::size_t i = 0; i < n; ++i) {
-            double worst = 0, vir = 0;
-            std::uint32_t nc = 0;
-            for (std::uint32_t k = pl.first[i]; k < pl.first[i + 1]; ++k) {
-                PairResult r;
-                if (pair(i, k, r, worst, vir)) {
-                    ++nc;
-                } else {
-                    r = PairResult{};
+/// The pass over particles [b, e) of tdm/forces.hpp (forceRange), for scenes with polygons: a particle's sums start
+/// (gravity, then the cross pairs where it is the partner) just before the first pair that adds to them, its own
+/// pairs scatter to both particles, and right after them it is finished (walls, torque, statistics). kCross: the
+/// pairs whose partner is >= e were evaluated before into cross[c0...] in pair order; crossIn: the cross pairs
+/// whose partner is in [b, e), by partner then pair.
+template <class Normal, class Tangential, bool kCross, class Pair>
+RangeTally polygonRange(Particles<2>& p, const PairList<2>& pl, const std::vector<Wall<2>>& walls,
+                        std::vector<V2>& wallHistory, const ContactSetup& cs, double time, double dt, const V2* sv,
+                        const Ang<2>* sw, PolygonScratch& ps, std::size_t b, std::size_t e,
+                        const PolygonCrossPair* crossPairs, std::size_t c0, const std::uint64_t* crossIn,
+                        const std::uint64_t* crossInEnd, double* virial, double* virialSum, Pair& pair) {
+    V2* f = p.f.data();
+    Ang<2>* tq = p.torque.data();  // holds the pair torques until the particle is finished
+    const double* mass = p.mass.data();
+    const V2 g = ps.gravity;
+    double* pairEnergy = ps.pairEnergy.data();
+    std::size_t done = b;
+    const std::uint64_t* q = crossIn;
+    auto startUpTo = [&](std::size_t end) {
+        for (; done < end; ++done) {
+            f[done] = g * mass[done];
+            tq[done][0] = 0;
+            if constexpr (kCross) {
+                for (; q != crossInEnd && (*q >> 32) == done; ++q) {
+                    const PolygonCrossPair& c = crossPairs[*q & 0xFFFFFFFFu];
+                    if (!c.touching) continue;
+                    f[done] -= c.r.f;
+                    tq[done][0] += c.r.tj;
                 }
-                s.pairForce[k] = r.f;
-                ps.torqueI[k] = r.ti;
-                ps.torqueJ[k] = r.tj;
-                ps.pairEnergy[k] = r.energy;
             }
-            s.maxOverlap[i] = worst;
-            s.contacts[i] = nc;
-            s.virial[i] = vir;
         }
-#pragma omp parallel for schedule(static)
-        for (std::size_t i = 0; i < n; ++i) {
-            V2 f = g * p.mass[i];
-            double tq = 0;
-            for (std::uint32_t q = pl.firstT[i]; q < pl.firstT[i + 1]; ++q) {
-                const std::uint32_t k = pl.pairT[q];
-                if (s.pairForce[k] == V2::zero() && ps.torqueJ[k] == 0) continue;
-                f -= s.pairForce[k];
-                tq += ps.torqueJ[k];
-            }
-            for (std::uint32_t k = pl.first[i]; k < pl.first[i + 1]; ++k) {
-                if (s.pairForce[k] == V2::zero() && ps.torqueI[k] == 0) continue;
-                f += s.pairForce[k];
-                tq += ps.torqueI[k];
-            }
-            p.f[i] = f;
-            torque[i] = tq;
-        }
-    }
-
-    // Walls, per particle in wall order.
+    };
     const std::size_t nw = walls.size();
-    std::size_t wallContacts = 0;
+    const bool clip = !cs.attraction;
     const ShapeTable& st = p.shapes;
-#pragma omp parallel for schedule(static) reduction(+ : wallContacts) if (threaded)
-    for (std::size_t i = 0; i < n; ++i) {
-        double tq = torque[i];
+    RangeTally out;
+    std::size_t c = c0;
+    for (std::size_t i = b; i < e; ++i) {
+        const std::uint32_t k0 = pl.first[i], k1 = pl.first[i + 1];
+        std::size_t reach = k1 > k0 ? std::size_t{pl.partner[k1 - 1]} + 1 : i + 1;
+        if constexpr (kCross) reach = std::min(reach, e);
+        startUpTo(std::max(reach, i + 1));
+        V2 fi = f[i];
+        double ti = tq[i][0];
+        double worst = 0, vir = 0;
+        std::uint32_t nc = 0;
+        for (std::uint32_t k = k0; k < k1; ++k) {
+            const std::uint32_t j = pl.partner[k];
+            if constexpr (kCross) {
+                if (j >= e) {
+                    const PolygonCrossPair& x = crossPairs[c++];
+                    if (!x.touching) continue;
+                    fi += x.r.f;
+                    ti += x.r.ti;
+                    vir += x.virial;
+                    worst = std::max(worst, x.overlap);
+                    ++nc;
+                    continue;
+                }
+            }
+            PairResult r;
+            if (!pair(i, k, r, worst, vir)) {
+                pairEnergy[k] = 0;
+                continue;
+            }
+            fi += r.f;
+            ti += r.ti;
+            f[j] -= r.f;
+            tq[j][0] += r.tj;
+            pairEnergy[k] = r.energy;
+            ++nc;
+        }
+
+        // Walls, in wall order.
+        double wallEnergy = 0;
         if (nw > 0 && !(p.flags[i] & kFrozen)) {
-            V2 f = p.f[i];
             const double ri = p.radius[i];
             const std::uint32_t si = p.shape[i];
             for (std::size_t w = 0; w < nw; ++w) {
@@ -277,53 +262,144 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
                     BodyState bw;
                     bw.v = wall.velocity;
                     bw.vStep = wall.velocity;
-                    const PolygonCoeffs& c = cs.polygonPair(p.material[i], wall.material);
+                    const PolygonCoeffs& pc = cs.polygonPair(p.material[i], wall.material);
                     const PairLengths len = wallLengths(ri);
-                    const ContactForce cf = polygonContact(c, o, bi, bw, &nrm, len, cs.attraction,
+                    const ContactForce cf = polygonContact(pc, o, bi, bw, &nrm, len, cs.attraction,
                                                            cs.tangential == TangentialLaw::Spring, dt, hist);
-                    f += cf.f;
-                    tq += cf.torqueI;
-                    ps.wallEnergy[i] += polygonContactEnergy(c, o, cf, len);
+                    fi += cf.f;
+                    ti += cf.torqueI;
+                    wallEnergy += polygonContactEnergy(pc, o, cf, len);
                     const double clen = norm(o.chord);
-                    s.maxOverlap[i] = std::max(s.maxOverlap[i], clen > 0 ? o.area / clen / ri : 1.0);
-                    ++wallContacts;
+                    worst = std::max(worst, clen > 0 ? o.area / clen / ri : 1.0);
+                    ++nc;
                     continue;
                 }
                 const double delta = ri - dist;
                 const double meff = p.mass[i];
                 const V2 dv = p.v[i] - wall.velocity;
                 const double gn = dot(dv, nrm);
-                const PairCoeffs& c = cs.pair(p.material[i], wall.material);
-                NormalResult nr = Normal::eval(c, delta, -gn, meff, ri);
+                const PairCoeffs& pc = cs.pair(p.material[i], wall.material);
+                NormalResult nr = Normal::eval(pc, delta, -gn, meff, ri);
                 if (clip && nr.fn < 0) nr.fn = 0;
-                f += nrm * nr.fn;
+                fi += nrm * nr.fn;
                 if constexpr (Tangential::kHasHistory) {
                     const V2 gg = dv - cross(p.w[i] * ri, nrm);
                     const V2 gt = gg - nrm * dot(gg, nrm);
                     const V2 gs = sv[i] - wall.velocity - cross(sw[i] * ri, nrm);
                     const V2 gst = gs - nrm * dot(gs, nrm);
-                    const V2 ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gst, hist, dt);
-                    f += ft;
-                    tq += cross(nrm, ft)[0] * (-ri);
+                    const V2 ft = Tangential::eval(pc, nr.fn, nr.k, meff, nrm, gt, gst, hist, dt);
+                    fi += ft;
+                    ti += cross(nrm, ft)[0] * (-ri);
                 }
-                s.maxOverlap[i] = std::max(s.maxOverlap[i], delta / ri);
-                ++wallContacts;
+                worst = std::max(worst, delta / ri);
+                ++nc;
             }
-            p.f[i] = f;
         }
-        p.torque[i][0] = tq;
-    }
-
-    ForceStats out;
-    out.contacts = wallContacts;
-    for (std::size_t i = 0; i < n; ++i) {
-        out.contacts += s.contacts[i];
-        if (s.maxOverlap[i] > out.maxOverlapRatio) {
-            out.maxOverlapRatio = s.maxOverlap[i];
+        f[i] = fi;
+        tq[i][0] = ti;
+        ps.wallEnergy[i] = wallEnergy;
+        out.contacts += nc;
+        if constexpr (kCross) virial[i] = vir;
+        else *virialSum += vir;
+        if (worst > out.maxOverlapRatio) {
+            out.maxOverlapRatio = worst;
             out.worstParticle = i;
         }
+        double sum = 0;  // a NaN anywhere reaches the force of its particle in the same step
+        for (int k = 0; k < 2; ++k) sum += fi[k] + p.x[i][k];
+        if (!std::isfinite(sum) && out.nonFinite == ForceStats::kNone) out.nonFinite = i;
     }
     return out;
+}
+
+/// Forces and torques of a 2D scene with polygons, at the predicted state (see tdm/forces.hpp for sv, sw).
+/// One thread: one pass over the particles (polygonRange). T threads: the ranges of PairList::split, as in
+/// tdm/forces.hpp; every particle sums its contributions in the same order either way.
+template <class Normal, class Tangential>
+ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vector<Wall<2>>& walls,
+                                std::vector<V2>& wallHistory, const ContactSetup& cs, const Domain<2>& dom,
+                                double time, double dt, const V2* sv, const Ang<2>* sw, PolygonScratch& ps) {
+    const std::size_t n = p.tdmCount();
+    rotateShapes(p, ps);
+    ps.pairEnergy.resize(pl.size());  // both written for every pair and particle below
+    ps.wallEnergy.resize(n);
+    ps.gravity = dom.gravity;
+    const int nm = cs.nMaterials;
+    const PairCoeffs* table = cs.table.data();
+    const int nt = n >= kParallelMin ? omp_get_max_threads() : 1;
+
+    // One pair, whichever its kind: force on i and the torques on i and j.
+    const PairInputs<2> in{p.x.data(),        p.v.data(),      p.w.data(),         p.radius.data(),
+                           p.invMass.data(),  p.material.data(), sv,               sw,
+                           pl.partner.data(), pl.shift.data(), pl.shiftVec.data(), pl.history.data(),
+                           table,             nm,              !cs.attraction,     dt};
+    // Inlined into each pass (GCC leaves a lambda used in three places out of line: 3 % more instructions).
+    auto pair = [&](std::size_t i, std::uint32_t k, PairResult& r, double& worst, double& vir)
+                    __attribute__((always_inline)) {
+        const std::uint32_t j = pl.partner[k];
+        if (p.shape[i] == kNoShape && p.shape[j] == kNoShape) {
+            PairForce<2> pf;
+            if (!evalPair<2, Normal, Tangential>(in, Owner<2>(in, i), k, pf, worst, vir)) return false;
+            r.f = pf.f;
+            r.ti = -p.radius[i] * pf.nxft[0];
+            r.tj = -p.radius[j] * pf.nxft[0];
+            r.energy = 0;  // disk pairs: TdmEngine::contactEnergy adds them from the overlaps
+            return true;
+        }
+        return evalPolygonPair(p, pl, cs, ps, sv, sw, dt, i, k, r, worst, vir);
+    };
+
+    ForceStats st;
+    if (nt <= 1) {
+        const RangeTally t = polygonRange<Normal, Tangential, false>(p, pl, walls, wallHistory, cs, time, dt, sv, sw,
+                                                                     ps, 0, n, nullptr, 0, nullptr, nullptr, nullptr,
+                                                                     &st.virial, pair);
+        st.contacts = t.contacts;
+        st.maxOverlapRatio = t.maxOverlapRatio;
+        st.worstParticle = t.worstParticle;
+        st.nonFinite = t.nonFinite;
+        return st;
+    }
+
+    if (pl.split.ranges() != static_cast<std::size_t>(nt)) buildThreadSplit(pl, nt);
+    const ThreadSplit& sp = pl.split;
+    const std::size_t ncross = sp.crossSlot.size();
+    ps.cross.resize(ncross);
+    ps.virial.resize(n);
+    ps.tally.assign(static_cast<std::size_t>(nt), RangeTally{});
+    PolygonCrossPair* cross = ps.cross.data();
+#pragma omp parallel num_threads(nt)
+    {
+        // The cross pairs first: every particle is still unfinished.
+#pragma omp for schedule(static)
+        for (std::size_t c = 0; c < ncross; ++c) {
+            PolygonCrossPair& x = cross[c];
+            const std::uint32_t k = sp.crossSlot[c];
+            x.overlap = 0;
+            x.virial = 0;
+            x.touching = pair(sp.crossOwner[c], k, x.r, x.overlap, x.virial);
+            ps.pairEnergy[k] = x.touching ? x.r.energy : 0.0;
+        }
+#pragma omp for schedule(static, 1)
+        for (int r = 0; r < nt; ++r) {
+            const std::uint64_t* ci = sp.crossIn.data();
+            ps.tally[r] = polygonRange<Normal, Tangential, true>(
+                p, pl, walls, wallHistory, cs, time, dt, sv, sw, ps, sp.start[r], sp.start[r + 1], cross,
+                sp.crossFirst[r], ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1], ps.virial.data(), nullptr,
+                pair);
+        }
+    }
+    // The one-thread reductions, in the same order.
+    for (const RangeTally& t : ps.tally) {
+        st.contacts += t.contacts;
+        if (t.maxOverlapRatio > st.maxOverlapRatio) {
+            st.maxOverlapRatio = t.maxOverlapRatio;
+            st.worstParticle = t.worstParticle;
+        }
+        if (st.nonFinite == ForceStats::kNone) st.nonFinite = t.nonFinite;
+    }
+    for (std::size_t i = 0; i < n; ++i) st.virial += ps.virial[i];
+    return st;
 }
 
 }  // namespace haet::polygon

@@ -218,24 +218,25 @@ struct Overlap {
 /// receives the overlap polygon (capacity kMaxClip). `pCentre`, `pRadius`: a circle holding P, if known; an edge of Q
 /// whose inner half-plane holds that whole circle cannot cut P and is skipped (one test instead of one per vertex).
 /// `pShift`: if given, P is taken moved by it (P[k] + *pShift), as the force loop keeps vertices about the centre.
+/// The clipping runs in P's frame (Q moved by -pShift, the centroid moved back at the end), so that the first edge
+/// reads P where it lies instead of a moved copy.
 inline Overlap clipOverlap(const V2* P, int np, const V2* Q, int nq, V2* out = nullptr, const V2* pCentre = nullptr,
                            double pRadius = 0, const V2* pShift = nullptr) {
     // Each vertex carries the owner of the edge that leaves it: 0 = P's outline, 1 = Q's.
+    static constexpr std::uint8_t kPTags[kMaxVertices] = {};
     VertexBuffer<kMaxClip> bufA, bufB;
     std::uint8_t tagA[kMaxClip], tagB[kMaxClip];
-    V2* cur = bufA.data();
-    V2* nxt = bufB.data();
-    std::uint8_t* ct = tagA;
-    std::uint8_t* nt = tagB;
+    const V2* cur = P;
+    const std::uint8_t* ct = kPTags;
+    V2* nxt = bufA.data();
+    std::uint8_t* nt = tagA;
+    const V2 shift = pShift ? *pShift : V2::zero();
+    const V2 centre = pCentre ? *pCentre - shift : V2::zero();
     int n = np;
-    for (int k = 0; k < np; ++k) {
-        cur[k] = pShift ? P[k] + *pShift : P[k];
-        ct[k] = 0;
-    }
     for (int e = 0; e < nq && n >= 3; ++e) {
-        const V2 q0 = Q[e], d = Q[e + 1 == nq ? 0 : e + 1] - q0;
+        const V2 q0 = Q[e] - shift, d = Q[e + 1 == nq ? 0 : e + 1] - Q[e];
         if (pCentre) {
-            const double sc = cross2(d, *pCentre - q0);  // |d| x the centre's distance inside the edge's line
+            const double sc = cross2(d, centre - q0);  // |d| x the centre's distance inside the edge's line
             if (sc > 0 && sc * sc >= pRadius * pRadius * norm2(d)) continue;
         }
         // Sides first: an edge that leaves every vertex inside changes nothing (the common case), one that leaves
@@ -272,8 +273,10 @@ inline Overlap clipOverlap(const V2* P, int np, const V2* Q, int nq, V2* out = n
             sa = sb;
             ta = ct[k];
         }
-        std::swap(cur, nxt);
-        std::swap(ct, nt);
+        cur = nxt;
+        ct = nt;
+        nxt = nxt == bufA.data() ? bufB.data() : bufA.data();
+        nt = nt == tagA ? tagB : tagA;
         n = m;
     }
     Overlap o;
@@ -297,12 +300,12 @@ inline Overlap clipOverlap(const V2* P, int np, const V2* Q, int nq, V2* out = n
     if (!(a2 > 0)) return o;
     const V2 c{{mx / (3 * a2), my / (3 * a2)}};
     o.area = 0.5 * a2;
-    o.centroid = o0 + c;
+    o.centroid = o0 + c + shift;
     o.chord = chord;
     o.spin = spin0 - dot(c, chord);
     o.vertices = n;
     if (out)
-        for (int k = 0; k < n; ++k) out[k] = cur[k];
+        for (int k = 0; k < n; ++k) out[k] = cur[k] + shift;
     return o;
 }
 

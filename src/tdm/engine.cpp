@@ -43,16 +43,7 @@ void TdmEngine<D>::computeForces(bool correct) {
             if (poly_) {  // polygons present: their loop (polygon/forces.hpp) also serves the disks among them
                 stats_ = polygon::computePolygonForces<N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs,
                                                              w_.domain, w_.time, s_.dt, motion_.v.data(),
-                                                             motion_.w.data(), scratch_, *poly_);
-                // The disk loop checks finiteness and sums the virial as it goes; the polygon loop leaves both.
-                const Particles<D>& p = w_.particles;
-                stats_.virial = 0;
-                for (double v : scratch_.virial) stats_.virial += v;
-                for (std::size_t i = 0; i < p.tdmCount() && stats_.nonFinite == ForceStats::kNone; ++i) {
-                    double sum = 0;
-                    for (int k = 0; k < D; ++k) sum += p.f[i][k] + p.x[i][k];
-                    if (!std::isfinite(sum)) stats_.nonFinite = i;
-                }
+                                                             motion_.w.data(), *poly_);
                 return;
             }
         }
