@@ -261,7 +261,7 @@ void collectPairs(std::size_t n, const Candidates& candidates, PairList<D>& out)
     }
 }
 
-/// Carries history from old (same particle numbering) into out; the transposed index is left to be built.
+/// Carries history from old (same particle numbering) into out; the thread split is left to be built.
 template <int D>
 void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
     const std::size_t np = out.first[n];
@@ -278,8 +278,6 @@ void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
             }
         }
     }
-    out.firstT.clear();
-    out.pairT.clear();
     out.split = ThreadSplit{};
 }
 
@@ -353,17 +351,6 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
 }
 
 template <int D>
-void buildTransposedIndex(PairList<D>& list) {
-    const std::size_t n = list.first.size() - 1, np = list.size();
-    list.firstT.assign(n + 1, 0);
-    for (std::size_t k = 0; k < np; ++k) ++list.firstT[list.partner[k] + 1];
-    for (std::size_t i = 0; i < n; ++i) list.firstT[i + 1] += list.firstT[i];
-    list.pairT.resize(np);
-    std::vector<std::uint32_t> fill(list.firstT.begin(), list.firstT.end() - 1);
-    for (std::size_t k = 0; k < np; ++k) list.pairT[fill[list.partner[k]]++] = static_cast<std::uint32_t>(k);
-}
-
-template <int D>
 void keepTouchingPairs(PairList<D>& list) {
     const std::size_t n = list.first.empty() ? 0 : list.first.size() - 1;
     std::uint32_t o = 0, k = 0;
@@ -384,8 +371,6 @@ void keepTouchingPairs(PairList<D>& list) {
     list.shift = std::vector<std::uint8_t>(list.shift.begin(), list.shift.begin() + o);
     list.history = list.history.empty() ? std::vector<Vec<D>>{}
                                         : std::vector<Vec<D>>(list.history.begin(), list.history.begin() + o);
-    std::vector<std::uint32_t>().swap(list.firstT);
-    std::vector<std::uint32_t>().swap(list.pairT);
     list.split = ThreadSplit{};
 }
 
@@ -551,8 +536,6 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
         }
     }
     list.shiftVec = makeShiftVectors(dom);
-    list.firstT.clear();  // the transposed index and the thread split are built by the force loop when needed
-    list.pairT.clear();
     list.split = ThreadSplit{};
     if (appended) {
         // Every new pair has a new particle as its second: it comes after the kept partners of its row.
@@ -642,8 +625,6 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
         list.partner[k] = kept[k].j;
         list.history[k] = kept[k].h;
     }
-    list.firstT.clear();
-    list.pairT.clear();
     list.split = ThreadSplit{};
 }
 
@@ -651,7 +632,6 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     template void buildPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&,              \
                                    const PairList<D>&, PairList<D>&);                                           \
     template void buildAllPairs<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, PairList<D>&); \
-    template void buildTransposedIndex<D>(PairList<D>&);                                                        \
     template void buildThreadSplit<D>(PairList<D>&, int);                                                       \
     template void keepTouchingPairs<D>(PairList<D>&);                                                           \
     template void wrapPositions<D>(Particles<D>&, const Domain<D>&);                                            \

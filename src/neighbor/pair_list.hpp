@@ -34,10 +34,6 @@ struct PairList {
     std::vector<std::uint8_t> shift;    ///< image-shift code of each pair, index into shiftVec
     std::vector<Vec<D>> history;        ///< tangential spring of each pair [m]; zero when not touching
     std::vector<Vec<D>> shiftVec;       ///< 3^D shift vectors [m]
-    // Transposed index: pairs in which particle k is the partner j, in increasing pair order. Only the threaded
-    // force loop needs it: buildTransposedIndex() makes it, a build leaves it empty.
-    std::vector<std::uint32_t> firstT;
-    std::vector<std::uint32_t> pairT;
     // The threaded disk force loop's split: buildThreadSplit() makes it, a build leaves it empty.
     ThreadSplit split;
 
@@ -55,10 +51,6 @@ struct NeighborSettings {
 template <int D>
 void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, const PairList<D>& old,
                    PairList<D>& out);
-
-/// Builds the transposed index (firstT, pairT) of a built list.
-template <int D>
-void buildTransposedIndex(PairList<D>& list);
 
 /// Keeps only the pairs whose tangential history is not zero (the contacts), in order, in arrays of their size:
 /// all that a rebuild carries over from the old list.

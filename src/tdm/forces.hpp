@@ -113,9 +113,6 @@ template <int D>
 struct ForceScratch {
     std::vector<PairBlock<D>> blocks;  ///< one per thread (forceRange)
     std::vector<CrossPair<D>> cross;  ///< the disk loop's cross pairs (PairList::split)
-    std::vector<Vec<D>> pairForce;    ///< polygon loop: force on i of each pair [N]
-    std::vector<double> maxOverlap;   ///< polygon loop, per particle: largest overlap / smaller radius
-    std::vector<std::uint32_t> contacts;  ///< polygon loop, per particle: own pairs and walls in contact
     std::vector<double> virial;       ///< per particle: sum over own pairs of r_ij . F_ij [N m]
     std::vector<RangeTally> tally;    ///< the disk loop's per-range statistics
 };
