@@ -354,10 +354,7 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
         const RangeTally t = polygonRange<Normal, Tangential, false>(p, pl, walls, wallHistory, cs, time, dt, sv, sw,
                                                                      ps, 0, n, nullptr, 0, nullptr, nullptr, nullptr,
                                                                      &st.virial, pair);
-        st.contacts = t.contacts;
-        st.maxOverlapRatio = t.maxOverlapRatio;
-        st.worstParticle = t.worstParticle;
-        st.nonFinite = t.nonFinite;
+        addTally(st, t);
         return st;
     }
 
@@ -390,14 +387,7 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
         }
     }
     // The one-thread reductions, in the same order.
-    for (const RangeTally& t : ps.tally) {
-        st.contacts += t.contacts;
-        if (t.maxOverlapRatio > st.maxOverlapRatio) {
-            st.maxOverlapRatio = t.maxOverlapRatio;
-            st.worstParticle = t.worstParticle;
-        }
-        if (st.nonFinite == ForceStats::kNone) st.nonFinite = t.nonFinite;
-    }
+    for (const RangeTally& t : ps.tally) addTally(st, t);
     for (std::size_t i = 0; i < n; ++i) st.virial += ps.virial[i];
     return st;
 }

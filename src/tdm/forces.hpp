@@ -48,6 +48,16 @@ struct RangeTally {
     std::size_t nonFinite = ForceStats::kNone;
 };
 
+/// Folds a range's statistics into the step's; ranges come in particle order, so the result is the one-thread one.
+inline void addTally(ForceStats& st, const RangeTally& t) {
+    st.contacts += t.contacts;
+    if (t.maxOverlapRatio > st.maxOverlapRatio) {
+        st.maxOverlapRatio = t.maxOverlapRatio;
+        st.worstParticle = t.worstParticle;
+    }
+    if (st.nonFinite == ForceStats::kNone) st.nonFinite = t.nonFinite;
+}
+
 /// What one pair adds to its owner (its partner gets -f and n x F_t): a cross pair evaluated before the ranges
 /// run (threaded path), or an entry of a PairBlock.
 template <int D>
@@ -591,10 +601,7 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
         const RangeTally t = forceRange<D, Normal, Tangential, false, kLanes>(p, in, first, wp, nw, wh, cs, time,
                                                                               g, 0, n, nullptr, 0, nullptr, nullptr,
                                                                               nullptr, &st.virial, s.blocks[0], then);
-        st.contacts = t.contacts;
-        st.maxOverlapRatio = t.maxOverlapRatio;
-        st.worstParticle = t.worstParticle;
-        st.nonFinite = t.nonFinite;
+        addTally(st, t);
         return st;
     }
 
@@ -632,14 +639,7 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
         }
     }
     // The one-thread reductions, in the same order.
-    for (const RangeTally& t : s.tally) {
-        st.contacts += t.contacts;
-        if (t.maxOverlapRatio > st.maxOverlapRatio) {
-            st.maxOverlapRatio = t.maxOverlapRatio;
-            st.worstParticle = t.worstParticle;
-        }
-        if (st.nonFinite == ForceStats::kNone) st.nonFinite = t.nonFinite;
-    }
+    for (const RangeTally& t : s.tally) addTally(st, t);
     for (std::size_t i = 0; i < n; ++i) st.virial += s.virial[i];
     return st;
 }
