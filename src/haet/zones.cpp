@@ -107,10 +107,10 @@ void ZoneGrid<D>::relabel(const std::vector<double>& volume, const std::vector<s
     }
     // Time-driven: a dense zone within `buffer` on every axis (a dilation, axis by axis).
     mark_ = dense_;
-    std::vector<std::uint8_t> next(total_);
+    markNext_.resize(total_);
     for (int k = 0; k < D && s_.buffer > 0; ++k) {
-        alongAxis(k, s_.buffer, mark_, next, [](std::uint8_t a, std::uint8_t b) -> std::uint8_t { return a | b; });
-        mark_.swap(next);
+        alongAxis(k, s_.buffer, mark_, markNext_, [](std::uint8_t a, std::uint8_t b) -> std::uint8_t { return a | b; });
+        mark_.swap(markNext_);
     }
     changed_ = 0;
     for (int z = 0; z < total_; ++z) {

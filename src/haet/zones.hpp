@@ -65,8 +65,8 @@ private:
     std::vector<double> phi_, phiSmooth_;
     std::vector<std::uint8_t> dense_, tdm_;
     std::vector<double> invCount_;  // 1 / zones in each zone's smoothing block
-    std::vector<double> sum_;       // scratch of relabel
-    std::vector<std::uint8_t> mark_;
+    std::vector<double> sum_;                   // scratch of relabel: the smoothing's sums
+    std::vector<std::uint8_t> mark_, markNext_;  // and the buffer's dilation
     std::size_t changed_ = 0;
 };
 

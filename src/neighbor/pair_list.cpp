@@ -464,8 +464,7 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
             freshList.push_back(static_cast<std::uint32_t>(k));
         }
     }
-    appended = appended && (freshList.empty() || freshList.front() == n - freshList.size()) &&
-               n - freshList.size() == nOld;
+    appended = appended && n - freshList.size() == nOld;  // then the kept ones are [0, nOld), the new ones the rest
     struct Entry {
         std::uint32_t a, b;
         std::uint8_t code;
@@ -492,32 +491,30 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
     // other way by skin/2 before the next build: a new particle is paired with it within skin + d_j, so that no
     // pair left out can touch while every particle stays within skin/2 of its reference.
     auto drift = [&](std::uint32_t j) { return ref && !fresh[j] ? norm(p.x[j] - ref[j]) : 0.0; };
-    // A few new particles are tested against all (a grid costs O(cells), and a tall box has many); many use a grid.
-    if (!freshList.empty() && freshList.size() * 64 <= n) {
-        // On open axes a partner farther than the largest reach along the axis is skipped before the full test.
-        double rmax = 0, dmax = 0;
+    // The largest reach of a new particle: two largest radii, the skin and the largest drift.
+    double rmax = 0, dmax = 0;
+    if (!freshList.empty())
         for (std::uint32_t i = 0; i < n; ++i) {
             rmax = std::max(rmax, p.radius[i]);
             if (ref) dmax = std::max(dmax, drift(i));
         }
-        const double reach = 2 * rmax + s.skin + dmax;
+    const double reach = 2 * rmax + s.skin + dmax;
+    // Pair (f, j) of new particle f, once per pair of two new ones. On open axes a partner beyond the reach along
+    // the axis is skipped before the full test.
+    auto consider = [&](std::uint32_t f, std::uint32_t j) {
+        if (j == f || (fresh[j] && j < f)) return;
+        for (int k = 0; k < D; ++k)
+            if (!dom.periodic[k] && std::abs(p.x[f][k] - p.x[j][k]) >= reach) return;
+        const std::uint32_t lo = std::min(f, j), hi = std::max(f, j);
+        std::uint8_t code;
+        if (testPair(p, dom, s, lo, hi, code, drift(j))) entries.push_back({lo, hi, code, Vec<D>::zero()});
+    };
+    // A few new particles are tested against all (a grid costs O(cells), and a tall box has many); many use a grid.
+    if (!freshList.empty() && freshList.size() * 64 <= n) {
         for (const std::uint32_t f : freshList)
-            for (std::uint32_t j = 0; j < n; ++j) {
-                if (j == f || (fresh[j] && j < f)) continue;
-                bool far = false;
-                for (int k = 0; k < D; ++k) far = far || (!dom.periodic[k] && std::abs(p.x[f][k] - p.x[j][k]) >= reach);
-                if (far) continue;
-                const std::uint32_t lo = std::min(f, j), hi = std::max(f, j);
-                std::uint8_t code;
-                if (testPair(p, dom, s, lo, hi, code, drift(j))) entries.push_back({lo, hi, code, Vec<D>::zero()});
-            }
+            for (std::uint32_t j = 0; j < n; ++j) consider(f, j);
     } else if (!freshList.empty()) {
-        double rmax = 0;
-        for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
-        double reach = 0;
-        if (ref)
-            for (std::uint32_t j = 0; j < n; ++j) reach = std::max(reach, drift(j));
-        const Grid<D> g(dom, std::max(2 * rmax + s.skin + reach, 1e-300), p);
+        const Grid<D> g(dom, std::max(reach, 1e-300), p);
         std::vector<std::uint32_t> cellStart, members;
         std::vector<int> cellOf;
         sortIntoCells(p, g, cellStart, members, cellOf);
@@ -525,14 +522,7 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
             int cells[27];
             const int nc = neighbourCells(g, dom, p.x[f], cells);
             for (int q = 0; q < nc; ++q)
-                for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) {
-                    const std::uint32_t j = members[a];
-                    if (j == f || (fresh[j] && j < f)) continue;  // a pair of two new particles once
-                    const std::uint32_t lo = std::min(f, j), hi = std::max(f, j);
-                    std::uint8_t code;
-                    if (testPair(p, dom, s, lo, hi, code, drift(j)))
-                        entries.push_back({lo, hi, code, Vec<D>::zero()});
-                }
+                for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) consider(f, members[a]);
         }
     }
     list.shiftVec = makeShiftVectors(dom);
