@@ -26,6 +26,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+using testing::coveredFraction;
 using testing::dataScenario;
 using testing::kineticEnergy;
 using testing::momentum;
@@ -435,39 +436,6 @@ TEST(HertzDamped, TsujiRestitutionDefaultContactEnd) { checkTsuji(false); }
 // ------------------------------------------------------------------------------------------------------------
 // 4. Settling in a closed box
 // ------------------------------------------------------------------------------------------------------------
-
-/// Volume (3D) or area (2D) fraction covered by the particles inside the box [lo, hi], by sampling a regular grid of
-/// spacing h (error ~ (h/a)^2, well below 1e-3 for h = a/10).
-template <int D>
-double coveredFraction(const Particles<D>& p, const Vec<D>& lo, const Vec<D>& hi, double h) {
-    std::array<long, 3> n{1, 1, 1};
-    for (int k = 0; k < D; ++k) n[k] = std::max(1L, static_cast<long>((hi[k] - lo[k]) / h));
-    std::vector<std::uint8_t> covered(n[0] * n[1] * n[2], 0);
-    auto centre = [&](int k, long c) { return lo[k] + (c + 0.5) * (hi[k] - lo[k]) / n[k]; };
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        std::array<long, 3> c0{0, 0, 0}, c1{0, 0, 0};
-        bool outside = false;
-        for (int k = 0; k < D; ++k) {
-            const double cell = (hi[k] - lo[k]) / n[k];
-            c0[k] = std::max(0L, static_cast<long>(std::floor((p.x[i][k] - p.radius[i] - lo[k]) / cell)));
-            c1[k] = std::min(n[k] - 1, static_cast<long>(std::floor((p.x[i][k] + p.radius[i] - lo[k]) / cell)));
-            if (c0[k] > c1[k]) outside = true;
-        }
-        if (outside) continue;
-        const double r2 = p.radius[i] * p.radius[i];
-        for (long a = c0[0]; a <= c1[0]; ++a)
-            for (long b = c0[1]; b <= c1[1]; ++b)
-                for (long c = c0[2]; c <= c1[2]; ++c) {
-                    double d2 = 0;
-                    const long idx[3] = {a, b, c};
-                    for (int k = 0; k < D; ++k) d2 += std::pow(centre(k, idx[k]) - p.x[i][k], 2);
-                    if (d2 <= r2) covered[(a * n[1] + b) * n[2] + c] = 1;
-                }
-    }
-    std::size_t s = 0;
-    for (auto v : covered) s += v;
-    return double(s) / covered.size();
-}
 
 // The measuring tool itself: a sphere (disk) wholly inside, and one cut in half by the box face.
 TEST(Settling, CoveredFractionOfKnownShapes) {

@@ -20,6 +20,7 @@
 namespace haet {
 namespace {
 
+using testing::coveredFraction;
 using testing::dataScenario;
 using testing::kineticEnergy;
 using testing::momentum;
@@ -57,38 +58,6 @@ TEST(ValidateElasticGas, Gear5Conserves3D) { elasticGas<3>("gas3d.toml"); }
 TEST(ValidateElasticGas, Gear5Conserves2D) { elasticGas<2>("gas2d.toml"); }
 
 // ---- settling of ~500 spheres / disks in a closed box ----
-
-/// Volume (area) fraction covered by particles inside [lo, hi], sampled on a grid of spacing about h.
-template <int D>
-double coveredFraction(const Particles<D>& p, const Vec<D>& lo, const Vec<D>& hi, double h) {
-    std::array<long, 3> n{1, 1, 1};
-    for (int k = 0; k < D; ++k) n[k] = std::max(1L, static_cast<long>((hi[k] - lo[k]) / h));
-    std::vector<std::uint8_t> covered(n[0] * n[1] * n[2], 0);
-    auto centre = [&](int k, long c) { return lo[k] + (c + 0.5) * (hi[k] - lo[k]) / n[k]; };
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        std::array<long, 3> c0{0, 0, 0}, c1{0, 0, 0};
-        bool outside = false;
-        for (int k = 0; k < D; ++k) {
-            const double cell = (hi[k] - lo[k]) / n[k];
-            c0[k] = std::max(0L, static_cast<long>(std::floor((p.x[i][k] - p.radius[i] - lo[k]) / cell)));
-            c1[k] = std::min(n[k] - 1, static_cast<long>(std::floor((p.x[i][k] + p.radius[i] - lo[k]) / cell)));
-            if (c0[k] > c1[k]) outside = true;
-        }
-        if (outside) continue;
-        const double r2 = p.radius[i] * p.radius[i];
-        for (long a = c0[0]; a <= c1[0]; ++a)
-            for (long b = c0[1]; b <= c1[1]; ++b)
-                for (long c = c0[2]; c <= c1[2]; ++c) {
-                    double d2 = 0;
-                    const long idx[3] = {a, b, c};
-                    for (int k = 0; k < D; ++k) d2 += std::pow(centre(k, idx[k]) - p.x[i][k], 2);
-                    if (d2 <= r2) covered[(a * n[1] + b) * n[2] + c] = 1;
-                }
-    }
-    std::size_t s = 0;
-    for (auto v : covered) s += v;
-    return double(s) / covered.size();
-}
 
 /// Runs a settling scene to its duration and checks: nobody lost, kinetic energy below kineticMax (N m g d), bulk
 /// packing fraction (one diameter from side walls and floor, 1.5 diameters below the highest centre) in range.
