@@ -34,6 +34,11 @@ struct PairCoeffs {
 struct LanePairCoeffs {
     Lanes knConst, knPerMeff, gnPerMeff, hertzK, dissipationTime, tsujiAlpha, ktRatio, ktConst, gtPerMeff, mu;
 
+    /// Every lane holds c.
+    explicit LanePairCoeffs(const PairCoeffs& c)
+        : knConst(c.knConst), knPerMeff(c.knPerMeff), gnPerMeff(c.gnPerMeff), hertzK(c.hertzK),
+          dissipationTime(c.dissipationTime), tsujiAlpha(c.tsujiAlpha), ktRatio(c.ktRatio), ktConst(c.ktConst),
+          gtPerMeff(c.gtPerMeff), mu(c.mu) {}
     /// Lane l holds table[idx[l]].
     LanePairCoeffs(const PairCoeffs* table, LaneIndex idx) {
         static_assert(sizeof(PairCoeffs) % sizeof(double) == 0);

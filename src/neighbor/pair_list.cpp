@@ -87,11 +87,13 @@ int neighbourCells(const Grid<D>& g, const Domain<D>& dom, const Vec<D>& x, int*
     return neighbourCellsOf<D>(g, dom, c, cells);
 }
 
-/// The neighbour cells of every occupied cell, each with the image-shift code of its particles: cell c's are
-/// entries [first[c], first[c] + count[c]). When every periodic axis has at least 3 cells (each no narrower
-/// than the cutoff), a neighbour cell reached across a periodic face holds only images shifted by one box
-/// length, and the code is exact. Otherwise offsets fold onto the same cell (neighbourCells de-duplicates them)
-/// and the code is kAnyShift: the pair test finds the minimum image itself.
+/// The neighbour cells of a cell, each with the image-shift code of its particles, computed for one cell at a
+/// time and kept until asked for another (particles come mostly cell by cell, so each cell's are computed about
+/// once; a table for the whole grid would hold 27 entries per occupied cell, megabytes at the rebuild's peak).
+/// When every periodic axis has at least 3 cells (each no narrower than the cutoff), a neighbour cell reached
+/// across a periodic face holds only images shifted by one box length, and the code is exact. Otherwise offsets
+/// fold onto the same cell (neighbourCells de-duplicates them) and the code is kAnyShift: the pair test finds the
+/// minimum image itself. One per thread.
 template <int D>
 struct CellNeighbours {
     static constexpr std::uint8_t kAnyShift = 0xFF;
@@ -99,54 +101,55 @@ struct CellNeighbours {
         int cell;
         std::uint8_t code;
     };
-    std::vector<std::uint32_t> first;
-    std::vector<std::uint8_t> count;
-    std::vector<Entry> list;
+    const Grid<D>* g;
+    const Domain<D>* dom;
+    bool exact;
+    int cell = -1;  ///< the cell whose neighbours list holds
+    int count = 0;
+    Entry list[27];
 
-    CellNeighbours(const Grid<D>& g, const Domain<D>& dom, const std::vector<std::uint32_t>& cellStart) {
-        bool exact = true;
-        for (int k = 0; k < D; ++k) exact = exact && (!dom.periodic[k] || g.n[k] >= 3);
-        first.assign(static_cast<std::size_t>(g.total), 0);
-        count.assign(static_cast<std::size_t>(g.total), 0);
+    CellNeighbours(const Grid<D>& grid, const Domain<D>& domain) : g(&grid), dom(&domain), exact(true) {
+        for (int k = 0; k < D; ++k) exact = exact && (!domain.periodic[k] || grid.n[k] >= 3);
+    }
+
+    /// Makes list[0, count) the neighbours of cell c.
+    void of(int c) {
+        if (c == cell) return;
+        cell = c;
+        std::array<int, D> cc;
+        int t = c;
+        for (int k = 0; k < D; ++k) {  // Grid::index is x fastest
+            cc[k] = t % g->n[k];
+            t /= g->n[k];
+        }
+        count = 0;
+        if (!exact) {
+            int cells[27];
+            const int nc = neighbourCellsOf<D>(*g, *dom, cc, cells);
+            for (int q = 0; q < nc; ++q) list[count++] = {cells[q], kAnyShift};
+            return;
+        }
         constexpr int m = (D == 2) ? 9 : 27;
-        for (int c = 0; c < g.total; ++c) {
-            if (cellStart[c] == cellStart[c + 1]) continue;
-            std::array<int, D> cc;
-            int t = c;
-            for (int k = 0; k < D; ++k) {  // Grid::index is x fastest
-                cc[k] = t % g.n[k];
-                t /= g.n[k];
-            }
-            first[c] = static_cast<std::uint32_t>(list.size());
-            if (!exact) {
-                int cells[27];
-                const int nc = neighbourCellsOf<D>(g, dom, cc, cells);
-                for (int q = 0; q < nc; ++q) list.push_back({cells[q], kAnyShift});
-                count[c] = static_cast<std::uint8_t>(nc);
-                continue;
-            }
-            for (int offset = 0; offset < m; ++offset) {
-                std::array<int, D> nc;
-                int u = offset, code = 0, mul = 1;
-                bool inside = true;
-                for (int k = 0; k < D && inside; ++k) {
-                    nc[k] = cc[k] + u % 3 - 1;
-                    u /= 3;
-                    int shift = 0;  // d = x_i - x_j + shift L: +1 for an image to the left of the box
-                    if (nc[k] < 0) {
-                        nc[k] += g.n[k];
-                        shift = 1;
-                    } else if (nc[k] >= g.n[k]) {
-                        nc[k] -= g.n[k];
-                        shift = -1;
-                    }
-                    inside = shift == 0 || dom.periodic[k];
-                    code += (shift + 1) * mul;
-                    mul *= 3;
+        for (int offset = 0; offset < m; ++offset) {
+            std::array<int, D> nc;
+            int u = offset, code = 0, mul = 1;
+            bool inside = true;
+            for (int k = 0; k < D && inside; ++k) {
+                nc[k] = cc[k] + u % 3 - 1;
+                u /= 3;
+                int shift = 0;  // d = x_i - x_j + shift L: +1 for an image to the left of the box
+                if (nc[k] < 0) {
+                    nc[k] += g->n[k];
+                    shift = 1;
+                } else if (nc[k] >= g->n[k]) {
+                    nc[k] -= g->n[k];
+                    shift = -1;
                 }
-                if (inside) list.push_back({g.index(nc), static_cast<std::uint8_t>(code)});
+                inside = shift == 0 || dom->periodic[k];
+                code += (shift + 1) * mul;
+                mul *= 3;
             }
-            count[c] = static_cast<std::uint8_t>(list.size() - first[c]);
+            if (inside) list[count++] = {g->index(nc), static_cast<std::uint8_t>(code)};
         }
     }
 };
@@ -320,13 +323,15 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
     sortIntoCells(p, g, cellStart, members, cellOf);
     out.shiftVec = makeShiftVectors(dom);
 
-    const CellNeighbours<D> nb(g, dom, cellStart);
+    std::vector<CellNeighbours<D>> nbs(static_cast<std::size_t>(omp_get_max_threads()), CellNeighbours<D>(g, dom));
     // A cell's members are in increasing index order: the partners j > i of each cell start after i.
     auto candidates = [&](std::size_t i, auto&& add) {
-        const auto* cells = nb.list.data() + nb.first[cellOf[i]];
+        CellNeighbours<D>& nb = nbs[static_cast<std::size_t>(omp_get_thread_num())];
+        nb.of(cellOf[i]);
+        const auto* cells = nb.list;
         const std::uint32_t* m = members.data();
         const bool frozen = s.excludeFrozenPairs && (p.flags[i] & kFrozen);
-        for (int q = 0, nc = nb.count[cellOf[i]]; q < nc; ++q) {
+        for (int q = 0, nc = nb.count; q < nc; ++q) {
             const std::uint32_t* end = m + cellStart[cells[q].cell + 1];
             const std::uint32_t* a = std::upper_bound(m + cellStart[cells[q].cell], end, static_cast<std::uint32_t>(i));
             const std::uint8_t code = cells[q].code;

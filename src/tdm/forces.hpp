@@ -416,7 +416,10 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
                 transpose4(rw[0].spring.c, rw[1].spring.c, rw[2].spring.c, rw[3].spring.c, t);
                 for (int k = 0; k < D; ++k) xi.c[k] = t[k];
             }
-            const LanePairCoeffs c(in.table, cc);
+            // Mostly the four pairs share one material pair: its coefficients broadcast, not gathered.
+            const LanePairCoeffs c = (cc[1] == cc[0] && cc[2] == cc[0] && cc[3] == cc[0])
+                                         ? LanePairCoeffs(in.table[it[0].coeff])
+                                         : LanePairCoeffs(in.table, cc);
             LaneVec<D> f;
             LaneVec<A> nxft;
             Lanes vir, overlap;
