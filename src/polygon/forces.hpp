@@ -135,7 +135,7 @@ inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
             if (!(hist == V2::zero())) hist = V2::zero();
             return false;
         }
-        o = clipOverlap(a, np, b, nq, nullptr, &d, ri, &d);
+        o = convexOverlap(a, np, b, nq, d, ri, d);
     } else {
         o = polygonDiskOverlap(p, ps, i, j, d);
     }
