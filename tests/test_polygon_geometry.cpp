@@ -214,7 +214,8 @@ TEST(PolygonOverlap, TwoCrossingPathOnDegenerateAndDeepContacts) {
         const Overlap r = clipOverlap(P.data(), np, Q.data(), nq);
         Overlap f;
         f.area = -1;
-        const bool ok = twoCrossingOverlap(P.data(), np, Q.data(), nq, zero, circumradius(P.data(), np, zero), zero, f);
+        const double radius = circumradius(P.data(), np, zero);
+        const bool ok = twoCrossingOverlap(P.data(), np, Q.data(), nq, zero, radius, zero, f);
         if (ok) {
             EXPECT_TRUE(std::isfinite(f.area) && std::isfinite(f.centroid[0]) && std::isfinite(f.chord[1])) << what;
             expectSameOverlap(f, r, 1.0, what);
@@ -254,7 +255,8 @@ TEST(PolygonOverlap, TwoCrossingPathOnDegenerateAndDeepContacts) {
         const double shift = (t % 4 == 0 ? 0.0 : rng.uniform(-1, 1)) * std::pow(10.0, -rng.uniform(5, 16));
         const double gap = 0.999e-3 * (1 - std::pow(10.0, -rng.uniform(2, 8)));
         const double dir = kPi / 3 * int(rng.uniform(0, 6));
-        const auto Q = moved(hex, V2{{gap * std::cos(dir) + shift * std::sin(dir), gap * std::sin(dir) - shift * std::cos(dir)}}, turn);
+        const V2 at{{gap * std::cos(dir) + shift * std::sin(dir), gap * std::sin(dir) - shift * std::cos(dir)}};
+        const auto Q = moved(hex, at, turn);
         const Overlap r = clipOverlap(hex.data(), 6, Q.data(), 6);
         Overlap f;
         if (twoCrossingOverlap(hex.data(), 6, Q.data(), 6, zero, R, zero, f)) {

@@ -312,25 +312,9 @@ inline Overlap clipOverlap(const V2* P, int np, const V2* Q, int nq, V2* out = n
     return o;
 }
 
-/// The common contact of clipOverlap computed directly: when the outlines of the convex counter-clockwise polygons
-/// P and Q cross exactly twice, the overlap is the run of P's vertices inside Q, the exit point S2, the run of Q's
-/// vertices from S2's edge on to the edge of the entry point S1, and S1 (Sutherland-Hodgman builds the same polygon
-/// by cutting P with every edge of Q in turn). Arguments as in clipOverlap, with the bounding circle (pCentre,
-/// pRadius) and pShift required; returns false, leaving `o` alone, when it cannot tell that the outlines cross
-/// exactly twice, and clipOverlap must run.
-///
-/// Every edge of Q that can reach P's bounding circle gives the sides of all of P's vertices, four at a time (the
-/// clipping's formula and convention: outside when side < 0); a vertex outside no edge is inside Q. Exactly two crossings follow when P's inside
-/// vertices form one run (between 1 and np - 1 vertices) and every edge of P with both ends outside Q has them
-/// outside one same edge of Q (such an edge cannot cross Q; a second run, or an edge crossing Q twice, would add
-/// crossings). The crossing on the edge leaving the run is the first exit over the edges of Q that its outer end is
-/// outside of (Cyrus-Beck), the one on the entering edge the last entry. It falls back when two edges of Q give the
-/// same crossing parameter (a vertex of Q on P's outline), when both crossings lie on one edge of Q in the wrong
-/// order (Q's outline would go all the way round), and when a vertex of a run of two or more of Q's vertices is not
-/// inside P (round-off near a vertex of Q). The chord is S2 - S1 and the spin about S1 is |S2 - S1|^2 / 2.
 namespace detail {
 
-/// twoCrossingOverlap for np <= 4 kBlocks (the blocks of four vertices unrolled).
+/// twoCrossingOverlap (below) for np <= 4 kBlocks (the blocks of four vertices unrolled).
 template <int kBlocks>
 inline bool twoCrossing(const V2* P, int np, const V2* Q, int nq, const V2& pCentre, double pRadius, const V2& pShift,
                         Overlap& o) {
@@ -457,6 +441,22 @@ inline bool twoCrossing(const V2* P, int np, const V2* Q, int nq, const V2& pCen
 
 }  // namespace detail
 
+/// The common contact of clipOverlap computed directly: when the outlines of the convex counter-clockwise polygons P
+/// and Q cross exactly twice, the overlap is the run of P's vertices inside Q, the exit point S2, the run of Q's
+/// vertices from S2's edge on to the edge of the entry point S1, and S1 (Sutherland-Hodgman builds the same polygon by
+/// cutting P with every edge of Q in turn). Arguments as in clipOverlap, with the bounding circle (pCentre, pRadius)
+/// and pShift required; returns false, leaving `o` alone, when it cannot tell that the outlines cross exactly twice,
+/// and clipOverlap must run.
+///
+/// Every edge of Q that can reach P's bounding circle gives the sides of all of P's vertices, four at a time (the
+/// clipping's formula and convention: outside when side < 0); a vertex outside no edge is inside Q. Exactly two
+/// crossings follow when P's inside vertices form one run (between 1 and np - 1 vertices) and every edge of P with both
+/// ends outside Q has them outside one same edge of Q (such an edge cannot cross Q; a second run, or an edge crossing Q
+/// twice, would add crossings). The crossing on the edge leaving the run is the first exit over the edges of Q that its
+/// outer end is outside of (Cyrus-Beck), the one on the entering edge the last entry. It falls back when two edges of Q
+/// give the same crossing parameter (a vertex of Q on P's outline), when both crossings lie on one edge of Q in the
+/// wrong order (Q's outline would go all the way round), and when a vertex of a run of two or more of Q's vertices is
+/// not inside P (round-off near a vertex of Q). The chord is S2 - S1 and the spin about S1 is |S2 - S1|^2 / 2.
 inline bool twoCrossingOverlap(const V2* P, int np, const V2* Q, int nq, const V2& pCentre, double pRadius,
                                const V2& pShift, Overlap& o) {
     if (np <= 4) return detail::twoCrossing<1>(P, np, Q, nq, pCentre, pRadius, pShift, o);
@@ -465,9 +465,9 @@ inline bool twoCrossingOverlap(const V2* P, int np, const V2* Q, int nq, const V
 }
 
 /// Overlap of two convex polygons as clipOverlap computes it (pCentre and pShift required): twoCrossingOverlap
-/// where it applies, else the clipping. Out of line: inlined into the force pass, it would crowd its registers.
-[[gnu::noinline]] inline Overlap convexOverlap(const V2* P, int np, const V2* Q, int nq, const V2& pCentre, double pRadius,
-                             const V2& pShift) {
+/// where it applies, else the clipping. Out of line, like the clipping (inlining that into the force pass cost 1 %).
+[[gnu::noinline]] inline Overlap convexOverlap(const V2* P, int np, const V2* Q, int nq, const V2& pCentre,
+                                               double pRadius, const V2& pShift) {
     Overlap o;
     if (twoCrossingOverlap(P, np, Q, nq, pCentre, pRadius, pShift, o)) return o;
     return clipOverlap(P, np, Q, nq, nullptr, &pCentre, pRadius, &pShift);
