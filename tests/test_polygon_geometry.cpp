@@ -160,6 +160,114 @@ TEST(PolygonOverlap, ClippedAreaMatchesExactReferenceOnRandomPairs) {
     record("worst_area_error", worst);
 }
 
+// The two-crossing path against the clipping (its reference twin) and the exact area: on random pairs, moved by a
+// shift as the force loop moves them, and on degenerate and deep contacts, where it must either agree or decline.
+// A thin sliver is ill-conditioned in either method: the crossings of nearly parallel edges move along them by
+// round-off over the angle between them, and the centroid's cross products lose round-off relative to scale^2
+// divided by the area; hence the tolerances grow with scale^2 / area.
+void expectSameOverlap(const Overlap& f, const Overlap& r, double scale, const char* what) {
+    EXPECT_NEAR(f.area, r.area, 1e-12 * scale * scale) << what;
+    if (r.area > 1e-14 * scale * scale) {
+        const double kappa = std::max(1.0, scale * scale / r.area);
+        EXPECT_LT(norm(f.centroid - r.centroid), 1e-12 * kappa * scale) << what;
+        EXPECT_LT(norm(f.chord - r.chord), 1e-12 * kappa * scale) << what;
+        EXPECT_NEAR(f.spin, r.spin, 1e-12 * kappa * scale * scale) << what;
+    }
+}
+
+TEST(PolygonOverlap, TwoCrossingPathMatchesClippingOnRandomPairs) {
+    Rng rng(12, 7);
+    int fast = 0, overlapping = 0, declined = 0;
+    for (int t = 0; t < 4000; ++t) {
+        const int np = 3 + int(rng.uniform() * 18), nq = 3 + int(rng.uniform() * 18);
+        const V2 at{{rng.uniform(-50, 50), rng.uniform(-50, 50)}};
+        const auto P = moved(randomConvexPolygon(rng, np, 1.0, 2.5, rng.uniform(0, 6.3)), at);
+        const auto Q = moved(randomConvexPolygon(rng, nq, rng.uniform(0.3, 1.5), 2.5, 0.0),
+                             at + V2{{rng.uniform(-2, 2), rng.uniform(-2, 2)}});
+        std::vector<V2> local = P;  // P about `at`, moved back by the shift
+        for (V2& v : local) v -= at;
+        const Overlap r = clipOverlap(P.data(), np, Q.data(), nq);
+        const double ref = referenceArea(P, Q);
+        overlapping += ref > 0;
+        Overlap f;
+        if (twoCrossingOverlap(local.data(), np, Q.data(), nq, at, 1.0, at, f)) {
+            fast += ref > 0;
+            expectSameOverlap(f, r, 1.0, "random pair");
+            EXPECT_NEAR(f.area, ref, 1e-11) << "pair " << t;
+        } else {
+            declined += ref > 0;
+        }
+        expectSameOverlap(convexOverlap(local.data(), np, Q.data(), nq, at, 1.0, at), r, 1.0, "convexOverlap");
+    }
+    // Most overlapping random pairs cross twice; the rest (one inside the other, deep crossings) fall back.
+    EXPECT_GT(fast, 3 * declined);
+    EXPECT_GT(declined, 0);
+    EXPECT_GT(overlapping, 1000);
+    record("two_crossing_share", double(fast) / overlapping);
+}
+
+TEST(PolygonOverlap, TwoCrossingPathOnDegenerateAndDeepContacts) {
+    const auto sq = rectangle(1.0, std::sqrt(2.0), 0.0);  // [-1, 1]^2
+    const V2 zero = V2::zero();
+    auto check = [&](const std::vector<V2>& P, const std::vector<V2>& Q, const char* what) {
+        const int np = int(P.size()), nq = int(Q.size());
+        const Overlap r = clipOverlap(P.data(), np, Q.data(), nq);
+        Overlap f;
+        f.area = -1;
+        const double radius = circumradius(P.data(), np, zero);
+        const bool ok = twoCrossingOverlap(P.data(), np, Q.data(), nq, zero, radius, zero, f);
+        if (ok) {
+            EXPECT_TRUE(std::isfinite(f.area) && std::isfinite(f.centroid[0]) && std::isfinite(f.chord[1])) << what;
+            expectSameOverlap(f, r, 1.0, what);
+        } else {
+            EXPECT_EQ(f.area, -1.0) << what;  // left alone
+        }
+        return ok;
+    };
+    // Touching from outside (vertex on vertex, edge on edge, vertex on edge): zero area when taken.
+    for (const V2 by : {V2{{2.0, 2.0}}, V2{{2.0, 0.0}}, V2{{2.0, 0.5}}, V2{{2.0, 1.0}}})
+        check(sq, moved(sq, by), "touching");
+    check(sq, moved(sq, V2{{1.0 + std::sqrt(2.0), 0.0}}, kPi / 4), "vertex on edge");
+    // Parallel overlapping edges, collinear side edges: vertices of P on Q's edge lines.
+    check(sq, moved(sq, V2{{1.5, 0.0}}), "parallel edges, collinear sides");
+    check(sq, moved(sq, V2{{1.5, 0.5}}), "parallel edges, offset");
+    EXPECT_TRUE(check(sq, moved(sq, V2{{1.5, 0.5}}), "parallel edges, offset"));
+    // Vertex on vertex inside: a corner of Q exactly on a corner of P, overlapping.
+    check(sq, moved(sq, V2{{1.0, 1.0}}), "corner on centre");
+    check(sq, moved(sq, V2{{0.5, 0.5}}, kPi / 4), "turned");
+    // Deep overlaps: four crossings (a plus sign), six (a hexagram), one inside the other: declined.
+    const auto thin = rectangle(4.0, std::sqrt(17.0) / 2, 0.0);
+    EXPECT_FALSE(check(thin, moved(thin, V2{{0.0, 0.1}}, kPi / 2), "plus"));
+    const auto tri = regularPolygon(3, 1.0, 0.0);
+    EXPECT_FALSE(check(tri, moved(tri, V2{{0.01, 0.0}}, kPi / 3), "hexagram"));
+    EXPECT_FALSE(check(rectangle(1.0, 0.3, 0.2), sq, "inside"));
+    EXPECT_FALSE(check(sq, rectangle(1.0, 0.3, 0.2), "around"));
+    // A thin slice of a vertex poking through an edge: Q's vertex inside P, no vertex of P inside Q.
+    check(sq, moved(regularPolygon(3, 1.0, kPi), V2{{2.0 - 1e-9, 0.0}}), "poke");
+    // Hexagons of the settling benchmark: flat faces pressed together, tiny turns and offsets, vertices nearly on
+    // vertices; the clipping and the direct path agree to round-off.
+    const double R = 0.999e-3 / std::sqrt(3.0);
+    const auto hex = regularPolygon(6, R, kPi / 6);
+    Rng rng(3, 3);
+    int taken = 0;
+    for (int t = 0; t < 2000; ++t) {
+        const double turn = rng.uniform(-1, 1) * std::pow(10.0, -rng.uniform(3, 16));
+        const double shift = (t % 4 == 0 ? 0.0 : rng.uniform(-1, 1)) * std::pow(10.0, -rng.uniform(5, 16));
+        const double gap = 0.999e-3 * (1 - std::pow(10.0, -rng.uniform(2, 8)));
+        const double dir = kPi / 3 * int(rng.uniform(0, 6));
+        const V2 at{{gap * std::cos(dir) + shift * std::sin(dir), gap * std::sin(dir) - shift * std::cos(dir)}};
+        const auto Q = moved(hex, at, turn);
+        const Overlap r = clipOverlap(hex.data(), 6, Q.data(), 6);
+        Overlap f;
+        if (twoCrossingOverlap(hex.data(), 6, Q.data(), 6, zero, R, zero, f)) {
+            ++taken;
+            expectSameOverlap(f, r, R, "hexagons");
+        }
+        expectSameOverlap(convexOverlap(hex.data(), 6, Q.data(), 6, zero, R, zero), r, R, "hexagons");
+    }
+    EXPECT_GT(taken, 1500);
+}
+
 TEST(PolygonOverlap, AreasMatchMonteCarlo) {
     std::mt19937_64 gen(4);
     std::uniform_real_distribution<double> u(-1.5, 1.5);

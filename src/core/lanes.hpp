@@ -72,6 +72,14 @@ inline bool anyOf(LaneMask m) {
     return (m.m[0] | m.m[1] | m.m[2] | m.m[3]) != 0;
 #endif
 }
+/// The mask as four bits, lane l in bit l.
+inline unsigned bitsOf(LaneMask m) {
+#ifdef __AVX__
+    return static_cast<unsigned>(_mm256_movemask_pd(reinterpret_cast<__m256d>(m.m)));
+#else
+    return unsigned(m.m[0] != 0) | unsigned(m.m[1] != 0) << 1 | unsigned(m.m[2] != 0) << 2 | unsigned(m.m[3] != 0) << 3;
+#endif
+}
 /// std::min(a, b) = (b < a) ? b : a, lane by lane.
 inline double minOf(double a, double b) { return std::min(a, b); }
 inline Lanes minOf(Lanes a, Lanes b) { return select(b < a, b, a); }

@@ -4,7 +4,8 @@
 //
 // Per pair (from the same pair list; the bounding circles are the particles' radii, so the cell grid is the
 // broad phase): two disks use the disk law (evalPair of tdm/forces.hpp); a polygon pair is screened by the
-// separating-axis test and then clipped; a polygon and a disk use the exact circle-polygon overlap. All overlaps
+// inscribed circles and the line of centres, then overlapped (convexOverlap: directly when the outlines cross
+// twice, else by clipping); a polygon and a disk use the exact circle-polygon overlap. All overlaps
 // go through polygonContact (polygon/contact.hpp). Walls: half-plane overlap for polygons, the disk law for disks.
 //
 // Summation order, hence thread-count independence, is that of tdm/forces.hpp: gravity, the pairs in which the
@@ -128,14 +129,14 @@ inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
         const V2* b = ps.rotated.data() + st.first[sj];
         // Broad phase passed (bounding circles). Inscribed circles that overlap mean overlapping polygons (most
         // touching pairs of a packing); otherwise the line of centres separates most remaining pairs cheaply (P's
-        // projections on d are a's shifted by |d|^2); the clipping finds that the others do not overlap (the full
+        // projections on d are a's shifted by |d|^2); the overlap finds that the others do not overlap (the full
         // separating-axis test, polygon::separated, would cost about as much as the clipping).
         const double rin = ps.inradius[si] + ps.inradius[sj];
         if (dist2 >= rin * rin && dist2 > 0 && separatedAlong(d, dist2, a, np, b, nq)) {
             if (!(hist == V2::zero())) hist = V2::zero();
             return false;
         }
-        o = clipOverlap(a, np, b, nq, nullptr, &d, ri, &d);
+        o = convexOverlap(a, np, b, nq, d, ri, d);
     } else {
         o = polygonDiskOverlap(p, ps, i, j, d);
     }

@@ -20,11 +20,14 @@
 // (vertex on vertex, edge on edge) give zero area.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <vector>
 
+#include "core/lanes.hpp"
 #include "core/rng.hpp"
 #include "core/vec.hpp"
 
@@ -307,6 +310,167 @@ inline Overlap clipOverlap(const V2* P, int np, const V2* Q, int nq, V2* out = n
     if (out)
         for (int k = 0; k < n; ++k) out[k] = cur[k] + shift;
     return o;
+}
+
+namespace detail {
+
+/// twoCrossingOverlap (below) for np <= 4 kBlocks (the blocks of four vertices unrolled).
+template <int kBlocks>
+inline bool twoCrossing(const V2* P, int np, const V2* Q, int nq, const V2& pCentre, double pRadius, const V2& pShift,
+                        Overlap& o) {
+    // P's coordinates side by side; the lanes past np repeat vertex 0 (their bits are dropped).
+    // (Filled as doubles, then loaded: writing single lanes becomes an instruction that valgrind cannot run.)
+    alignas(32) double xs[4 * kBlocks], ys[4 * kBlocks];
+    for (int k = 0; k < 4 * kBlocks; ++k) {
+        const V2& v = P[k < np ? k : 0];
+        xs[k] = v[0];
+        ys[k] = v[1];
+    }
+    Lanes px[kBlocks], py[kBlocks];
+    for (int bl = 0; bl < kBlocks; ++bl) {
+        std::memcpy(&px[bl].v, xs + 4 * bl, sizeof px[bl].v);
+        std::memcpy(&py[bl].v, ys + 4 * bl, sizeof py[bl].v);
+    }
+    alignas(32) double side[kMaxVertices][4 * kBlocks];  // [edge of Q][vertex of P]
+    std::uint32_t outE[kMaxVertices];  // per edge of Q that cuts P: bit k set when vertex k of P is outside
+    int cut[kMaxVertices], ncut = 0;   // those edges
+    const std::uint32_t all = (std::uint32_t{1} << np) - 1;
+    std::uint32_t outAny = 0, shared = 0;
+    const auto next = [&](std::uint32_t m) { return (m >> 1) | ((m & 1u) << (np - 1)); };  // bit k: vertex k + 1
+    const V2 centre = pCentre - pShift;
+    const double r2 = pRadius * pRadius;
+    for (int e = 0; e < nq; ++e) {
+        const V2 q0 = Q[e] - pShift, d = Q[e + 1 == nq ? 0 : e + 1] - Q[e];
+        const double sc = cross2(d, centre - q0);  // |d| x the centre's distance inside the edge's line
+        if (sc > 0 && sc * sc >= r2 * norm2(d)) continue;  // cannot reach P's bounding circle
+        const Lanes dx(d[0]), dy(d[1]), qx(q0[0]), qy(q0[1]);
+        std::uint32_t out = 0;
+        for (int bl = 0; bl < kBlocks; ++bl) {
+            const Lanes s = dx * (py[bl] - qy) - dy * (px[bl] - qx);  // cross2(d, P[k] - q0)
+            std::memcpy(side[e] + 4 * bl, &s.v, sizeof s.v);
+            out |= bitsOf(s < Lanes(0.0)) << (4 * bl);
+        }
+        out &= all;
+        if (out == all) {  // P outside one edge line of Q: apart
+            o = Overlap{};
+            return true;
+        }
+        if (!out) continue;
+        outE[ncut] = out;
+        cut[ncut++] = e;
+        outAny |= out;
+        shared |= out & next(out);  // edges of P with both ends outside edge e
+    }
+    const std::uint32_t in = all & ~outAny;
+    const std::uint32_t leaving = in & ~next(in) & all, entering = ~in & next(in) & all;
+    if (std::popcount(leaving) != 1) return false;      // no run, all inside, or more than one run
+    if (outAny & next(outAny) & ~shared) return false;  // an edge of P with both ends outside might cross Q
+    const int leave = std::countr_zero(leaving), enter = std::countr_zero(entering);
+    // Exit from Q on P's edge leave -> a: the smallest parameter over the edges that a is outside of.
+    const int a = leave + 1 == np ? 0 : leave + 1;
+    int j2 = -1;
+    double t2 = 2;
+    for (int c = 0; c < ncut; ++c) {
+        if (!(outE[c] >> a & 1u)) continue;
+        const int e = cut[c];
+        const double sa = side[e][leave], t = sa / (sa - side[e][a]);
+        if (t == t2) return false;
+        if (t < t2) {
+            t2 = t;
+            j2 = e;
+        }
+    }
+    // Entry into Q on P's edge enter -> b: the largest parameter over the edges that `enter` is outside of.
+    const int b = enter + 1 == np ? 0 : enter + 1;
+    int j1 = -1;
+    double t1 = -1;
+    for (int c = 0; c < ncut; ++c) {
+        if (!(outE[c] >> enter & 1u)) continue;
+        const int e = cut[c];
+        const double sa = side[e][enter], t = sa / (sa - side[e][b]);
+        if (t == t1) return false;
+        if (t > t1) {
+            t1 = t;
+            j1 = e;
+        }
+    }
+    const V2 s1 = P[enter] + (P[b] - P[enter]) * t1;
+    const V2 s2 = P[leave] + (P[a] - P[leave]) * t2;
+    if (j1 == j2 && !(dot(s1 - s2, Q[j1 + 1 == nq ? 0 : j1 + 1] - Q[j1]) > 0)) return false;
+    // The overlap polygon relative to S1: S1, P's run, S2, Q's run.
+    VertexBuffer<kMaxClip> poly;
+    int n = 0;
+    poly[n++] = V2::zero();
+    for (int k = b;; k = k + 1 == np ? 0 : k + 1) {
+        poly[n++] = P[k] - s1;
+        if (k == leave) break;
+    }
+    poly[n++] = s2 - s1;
+    // Round-off can pick the wrong one of two edges of Q only at a vertex of Q where both give the same crossing
+    // (to round-off): adding or dropping that vertex, next to S1 or S2, changes nothing that matters, unless the
+    // picks swap the order of S1 and S2 and Q's run goes the other way round, over nq - 1 >= 2 vertices. So runs of
+    // two or more vertices are checked to lie inside P.
+    const int nRunQ = j1 >= j2 ? j1 - j2 : j1 - j2 + nq;
+    for (int j = j2; j != j1;) {
+        j = j + 1 == nq ? 0 : j + 1;
+        const V2 v = Q[j] - pShift;
+        if (nRunQ >= 2)
+            for (int k = 0; k < np; ++k)
+                if (cross2(P[k + 1 == np ? 0 : k + 1] - P[k], v - P[k]) < 0) return false;
+        poly[n++] = v - s1;
+    }
+    double a2 = 0, mx = 0, my = 0;
+    for (int k = 1; k + 1 < n; ++k) {  // the two edges at S1 = 0 add nothing
+        const V2 p = poly[k], q = poly[k + 1];
+        const double cr = cross2(p, q);
+        a2 += cr;
+        mx += (p[0] + q[0]) * cr;
+        my += (p[1] + q[1]) * cr;
+    }
+    o = Overlap{};
+    if (!(a2 > 0)) return true;
+    const V2 chord = poly[n - 1 - nRunQ];  // S2 - S1
+    const V2 c{{mx / (3 * a2), my / (3 * a2)}};
+    o.area = 0.5 * a2;
+    o.centroid = s1 + c + pShift;
+    o.chord = chord;
+    o.spin = 0.5 * norm2(chord) - dot(c, chord);
+    o.vertices = n;
+    return true;
+}
+
+}  // namespace detail
+
+/// The common contact of clipOverlap computed directly: when the outlines of the convex counter-clockwise polygons P
+/// and Q cross exactly twice, the overlap is the run of P's vertices inside Q, the exit point S2, the run of Q's
+/// vertices from S2's edge on to the edge of the entry point S1, and S1 (Sutherland-Hodgman builds the same polygon by
+/// cutting P with every edge of Q in turn). Arguments as in clipOverlap, with the bounding circle (pCentre, pRadius)
+/// and pShift required; returns false, leaving `o` alone, when it cannot tell that the outlines cross exactly twice,
+/// and clipOverlap must run.
+///
+/// Every edge of Q that can reach P's bounding circle gives the sides of all of P's vertices, four at a time (the
+/// clipping's formula and convention: outside when side < 0); a vertex outside no edge is inside Q. Exactly two
+/// crossings follow when P's inside vertices form one run (between 1 and np - 1 vertices) and every edge of P with both
+/// ends outside Q has them outside one same edge of Q (such an edge cannot cross Q; a second run, or an edge crossing Q
+/// twice, would add crossings). The crossing on the edge leaving the run is the first exit over the edges of Q that its
+/// outer end is outside of (Cyrus-Beck), the one on the entering edge the last entry. It falls back when two edges of Q
+/// give the same crossing parameter (a vertex of Q on P's outline), when both crossings lie on one edge of Q in the
+/// wrong order (Q's outline would go all the way round), and when a vertex of a run of two or more of Q's vertices is
+/// not inside P (round-off near a vertex of Q). The chord is S2 - S1 and the spin about S1 is |S2 - S1|^2 / 2.
+inline bool twoCrossingOverlap(const V2* P, int np, const V2* Q, int nq, const V2& pCentre, double pRadius,
+                               const V2& pShift, Overlap& o) {
+    if (np <= 4) return detail::twoCrossing<1>(P, np, Q, nq, pCentre, pRadius, pShift, o);
+    if (np <= 8) return detail::twoCrossing<2>(P, np, Q, nq, pCentre, pRadius, pShift, o);
+    return detail::twoCrossing<(kMaxVertices + 3) / 4>(P, np, Q, nq, pCentre, pRadius, pShift, o);
+}
+
+/// Overlap of two convex polygons as clipOverlap computes it (pCentre and pShift required): twoCrossingOverlap
+/// where it applies, else the clipping. Out of line, like the clipping (inlining that into the force pass cost 1 %).
+[[gnu::noinline]] inline Overlap convexOverlap(const V2* P, int np, const V2* Q, int nq, const V2& pCentre,
+                                               double pRadius, const V2& pShift) {
+    Overlap o;
+    if (twoCrossingOverlap(P, np, Q, nq, pCentre, pRadius, pShift, o)) return o;
+    return clipOverlap(P, np, Q, nq, nullptr, &pCentre, pRadius, &pShift);
 }
 
 /// Overlap of the disk of radius R centred at the origin with the convex counter-clockwise polygon Q (the first
