@@ -555,12 +555,28 @@ template <int D>
         R = b[3].v;
     } else {
         const Hot &h0 = hot_[j[0]], &h1 = hot_[j[1]], &h2 = hot_[j[2]], &h3 = hot_[j[3]];
+#ifdef __AVX__
+        // 2D: (x0, x1, t, v0) and (v1, r) of each record (48 bytes, 16-aligned), transposed into lanes.
+        const __m256d a0 = _mm256_loadu_pd(h0.x.c.data()), a1 = _mm256_loadu_pd(h1.x.c.data()),
+                      a2 = _mm256_loadu_pd(h2.x.c.data()), a3 = _mm256_loadu_pd(h3.x.c.data());
+        const __m256d lo01 = _mm256_unpacklo_pd(a0, a1), hi01 = _mm256_unpackhi_pd(a0, a1);
+        const __m256d lo23 = _mm256_unpacklo_pd(a2, a3), hi23 = _mm256_unpackhi_pd(a2, a3);
+        X[0] = _mm256_permute2f128_pd(lo01, lo23, 0x20);
+        X[1] = _mm256_permute2f128_pd(hi01, hi23, 0x20);
+        T = _mm256_permute2f128_pd(lo01, lo23, 0x31);
+        Vv[0] = _mm256_permute2f128_pd(hi01, hi23, 0x31);
+        const __m256d b02 = _mm256_set_m128d(_mm_load_pd(h2.v.c.data() + 1), _mm_load_pd(h0.v.c.data() + 1));
+        const __m256d b13 = _mm256_set_m128d(_mm_load_pd(h3.v.c.data() + 1), _mm_load_pd(h1.v.c.data() + 1));
+        Vv[1] = _mm256_unpacklo_pd(b02, b13);
+        R = _mm256_unpackhi_pd(b02, b13);
+#else
         for (int k = 0; k < D; ++k) {
             X[k] = V{h0.x[k], h1.x[k], h2.x[k], h3.x[k]};
             Vv[k] = V{h0.v[k], h1.v[k], h2.v[k], h3.v[k]};
         }
         T = V{h0.t, h1.t, h2.t, h3.t};
         R = V{h0.r, h1.r, h2.r, h3.r};
+#endif
     }
     const V zero = {0, 0, 0, 0};
     const V tsL = sc.t;
