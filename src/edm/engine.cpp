@@ -494,15 +494,6 @@ inline double EdmEngine<D>::candidateTime(const Hot& hs, std::uint32_t s, std::u
     return t < now ? pairTimeFromNow(s, j, m, now) : t;
 }
 
-// Four candidates side by side: the arithmetic of candidateTime lane by lane (the same correctly rounded operations in
-// the same order, no fused multiply-add), so a lane gives the bits candidateTime gives. Both states are extrapolated
-// to the later clock tr, one of them by zero, which leaves it unchanged (x + (v + g/2 0) 0 = x), as candidateTime's
-// two branches do. The tests a lane can fail cheaply (receding, b >= 0; root beyond the best event so far by the
-// lower bound c / (-2 b)) are taken for all four at once; most batches end there. A lane that needs more than the
-// quadratic (a frozen partner, a root before now, no relative speed) goes to candidateTime. The lanes are then
-// offered to best in order, as the scalar loop would: the result is the minimum of (time, code), which does not
-// depend on the order, and a skip against the best time before the batch (not the best within it) only skips
-// less.
 namespace {
 /// Whether some lane of a comparison's result is set.
 template <class M>
@@ -515,6 +506,7 @@ inline bool anyLane(M m) {
 }
 }  // namespace
 
+// The scanning slot's state and the constants, one value per lane (candidates4).
 template <int D>
 typename EdmEngine<D>::ScanState EdmEngine<D>::scanState(const Hot& hs) const {
     ScanState sc;
@@ -530,6 +522,15 @@ typename EdmEngine<D>::ScanState EdmEngine<D>::scanState(const Hot& hs) const {
     return sc;
 }
 
+// Four candidates side by side: the arithmetic of candidateTime lane by lane (the same correctly rounded operations in
+// the same order, no fused multiply-add), so a lane gives the bits candidateTime gives. Both states are extrapolated
+// to the later clock tr, one of them by zero, which leaves it unchanged (x + (v + g/2 0) 0 = x), as candidateTime's
+// two branches do. The tests a lane can fail cheaply (receding, b >= 0; root beyond the best event so far by the
+// lower bound c / (-2 b)) are taken for all four at once; most batches end there. A lane that needs more than the
+// quadratic (a frozen partner, a root before now, no relative speed) goes to candidateTime. The lanes are then
+// offered to best in order, as the scalar loop would: the result is the minimum of (time, code), which does not
+// depend on the order, and a skip against the best time before the batch (not the best within it) only skips
+// less.
 template <int D>
 [[gnu::always_inline]] inline void EdmEngine<D>::candidates4(const ScanState& sc, const Hot& hs, std::uint32_t s,
                                                              const Batch& bt, std::uint32_t wsPacked,
