@@ -72,9 +72,11 @@ std::uint64_t compareWithReference(const World<D>& w, EdmSettings s, std::size_t
     EXPECT_GE(ref.size(), minCollisions);
     s.reference = false;
     std::uint64_t growths = 0;
+    const double cellSize = s.cellSize;  // for the cell crossings; shells take their own default
     for (const double shell : {0.0, 0.2, 0.7}) {
         SCOPED_TRACE(shell == 0 ? std::string("cell crossings") : "neighbour shells " + std::to_string(shell));
         s.shell = shell;
+        s.cellSize = shell > 0 ? 0 : cellSize;
         EdmStats st;
         const auto fast = runLogged(w, s, tEnd, &st);
         growths += st.listGrowths;
@@ -135,10 +137,29 @@ TEST(EdmEngine, MatchesReference3DPeriodicPartialScans) {
     EdmSettings s;
     s.tcModel = false;
     s.tangential = EdmSettings::Tangential::Constant;
+    s.cellSize = 2 * g.radius;  // one diameter (the default for this dilute gas without gravity is coarser)
     World<3> w = makeGas<3>(g, edmContact(1.0, 0.0, 1.0));
     {
         World<3> probe = w;
         const EdmEngine<3> eng(probe, s);
+        for (int k = 0; k < 3; ++k) ASSERT_GE(eng.cellDims()[k], 7);
+    }
+    compareWithReference<3>(w, s, 4000);
+}
+
+// A dilute gas without gravity gets cells coarser than a diameter by default (2.5 per particle), with partial scans.
+TEST(EdmEngine, MatchesReference3DPeriodicCoarseCells) {
+    GasSpec g;
+    g.n = 250;
+    g.phi = 0.08;
+    g.seed = 7;
+    EdmSettings s;
+    s.tcModel = false;
+    World<3> w = makeGas<3>(g, edmContact(1.0));
+    {
+        World<3> probe = w;
+        const EdmEngine<3> eng(probe, s);
+        ASSERT_GT(eng.cellSize(), 1.2 * 2 * g.radius);
         for (int k = 0; k < 3; ++k) ASSERT_GE(eng.cellDims()[k], 7);
     }
     compareWithReference<3>(w, s, 4000);
@@ -480,6 +501,32 @@ TEST(EdmEngine, SameRunHoldingState) {
     b.reset();
     s.firstParticle = 1;
     EXPECT_THROW({ EdmEngine<3> c(shared, s); }, std::invalid_argument);
+}
+
+// Default cell edge: one diameter, or in a dilute 3D gas without gravity the edge of 2.5 cells per particle.
+TEST(EdmEngine, DefaultCellsOfDiluteGas) {
+    GasSpec g;
+    g.n = 1000;
+    g.phi = 0.1;
+    g.seed = 3;
+    World<3> w = makeGas<3>(g, edmContact(1.0));
+    const double perParticle = (4.0 / 3.0) * M_PI * std::pow(g.radius, 3) / g.phi;
+    {
+        World<3> probe = w;
+        const EdmEngine<3> eng(probe, EdmSettings{});
+        EXPECT_NEAR(eng.cellSize(), std::cbrt(perParticle / 2.5), 0.15 * eng.cellSize());  // whole cells per axis
+        EXPECT_GT(eng.cellSize(), 1.1 * 2 * g.radius);
+        EXPECT_LE(eng.cellCount(), 2.5 * g.n);
+    }
+    g.phi = 0.3;  // denser: cells of one diameter
+    {
+        World<3> dense = makeGas<3>(g, edmContact(1.0));
+        const EdmEngine<3> eng(dense, EdmSettings{});
+        EXPECT_NEAR(eng.cellSize(), 2 * g.radius, 0.15 * g.radius);
+    }
+    w.domain.gravity[2] = -1;  // gravity: cells of one diameter, whatever the mean density
+    const EdmEngine<3> eng(w, EdmSettings{});
+    EXPECT_NEAR(eng.cellSize(), 2 * g.radius, 0.15 * g.radius);
 }
 
 TEST(EdmEngine, RejectsBadSettings) {

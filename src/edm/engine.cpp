@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/lanes.hpp"
 #include "edm/predict.hpp"
 
 namespace haet {
@@ -182,6 +183,16 @@ template <int D>
 void EdmEngine<D>::buildGrid() {
     const double least = 2 * rmax_ + (shells_ ? 2 * shellHalf_ : 0);
     double edge = s_.cellSize > 0 ? s_.cellSize : least;
+    // A dilute 3D gas without gravity (no heap forms, the density stays near its mean): cells of at least the edge
+    // that gives kCellsPerParticle cells per particle. At phi = 0.1 cells of one diameter are 5.2 per particle (21
+    // bytes of list heads each) and most events are cell crossings; 1.28 diameters take 2.5 (docs/edm.md).
+    if (!(s_.cellSize > 0) && D == 3 && norm2(g_) == 0 && !shells_ && w_.particles.size() > 0) {
+        constexpr double kCellsPerParticle = 2.5;
+        double vol = 1;
+        for (int k = 0; k < D; ++k) vol *= boxLen_[k];
+        const double mean = std::cbrt(vol / (kCellsPerParticle * static_cast<double>(w_.particles.size())));
+        if (std::isfinite(mean)) edge = std::max(edge, mean);
+    }
     if (s_.cellSize > 0 && s_.cellSize < least * (1 - 1e-12))
         throw std::invalid_argument(shells_ ? "event-driven engine: cellSize is smaller than the largest diameter "
                                               "plus the neighbour shell"
@@ -212,8 +223,7 @@ void EdmEngine<D>::buildGrid() {
     head_.assign(total, kNil);
     // Index offsets of the 3^D neighbours of a cell away from the faces, and of the 3^(D-1) new neighbours after a
     // step along axis a in direction d (deltaSide_[2 a + (d > 0)]).
-    deltaFull_.clear();
-    for (auto& v : deltaSide_) v.clear();
+    std::array<int, 2 * D> sideCount{};
     constexpr int m = D == 3 ? 27 : 9;
     for (int code = 0; code < m; ++code) {
         std::array<int, D> o;
@@ -224,9 +234,12 @@ void EdmEngine<D>::buildGrid() {
             t /= 3;
             delta += o[k] * static_cast<std::int32_t>(stride_[k]);
         }
-        deltaFull_.push_back(delta);
+        deltaFull_[code] = delta;
         for (int k = 0; k < D; ++k)
-            if (o[k] != 0) deltaSide_[2 * k + (o[k] > 0 ? 1 : 0)].push_back(delta);
+            if (o[k] != 0) {
+                const int side = 2 * k + (o[k] > 0 ? 1 : 0);
+                deltaSide_[side][sideCount[side]++] = delta;
+            }
     }
 }
 
@@ -439,9 +452,8 @@ double EdmEngine<D>::wallTime(std::uint32_t s, std::size_t w, double now) const 
 // The canonical form of pairTime for moving slot s (state hs) and slot j seen through the image shift m, written
 // out for speed: the older of the two states is extrapolated to the other's clock (an extrapolation by zero leaves a
 // state unchanged, so skipping it gives the same bits). A candidate whose root cannot come before bestTime gives
-// kNever without the square root or the division. The same arithmetic as the cell scan in predict, which keeps its
-// own copy: written there with the image shift of the cell and gravity hoisted out of the loop, the cell scan took
-// 7 % fewer instructions (callgrind, 3D phi = 0.1 and 0.3).
+// kNever without the square root or the division. The scalar twin of candidates4, which evaluates four candidates
+// side by side with the same arithmetic and hands it the lanes it does not finish (frozen partner, root before now).
 template <int D>
 inline double EdmEngine<D>::candidateTime(const Hot& hs, std::uint32_t s, std::uint32_t j, const Shift& m, double now,
                                           double bestTime) const {
@@ -482,6 +494,161 @@ inline double EdmEngine<D>::candidateTime(const Hot& hs, std::uint32_t s, std::u
     return t < now ? pairTimeFromNow(s, j, m, now) : t;
 }
 
+namespace {
+/// Whether some lane of a comparison's result is set.
+template <class M>
+inline bool anyLane(M m) {
+#ifdef __AVX__
+    return _mm256_movemask_pd(reinterpret_cast<__m256d>(m)) != 0;
+#else
+    return (m[0] | m[1] | m[2] | m[3]) != 0;
+#endif
+}
+}  // namespace
+
+// The scanning slot's state and the constants, one value per lane (candidates4).
+template <int D>
+typename EdmEngine<D>::ScanState EdmEngine<D>::scanState(const Hot& hs) const {
+    ScanState sc;
+    for (int k = 0; k < D; ++k) {
+        sc.x[k] = Lanes(hs.x[k]).v;
+        sc.v[k] = Lanes(hs.v[k]).v;
+        sc.gh[k] = Lanes(0.5 * g_[k]).v;
+        sc.g[k] = Lanes(g_[k]).v;
+        sc.len[k] = Lanes(boxLen_[k]).v;
+    }
+    sc.t = Lanes(hs.t).v;
+    sc.r = Lanes(hs.r).v;
+    return sc;
+}
+
+// Four candidates side by side: the arithmetic of candidateTime lane by lane (the same correctly rounded operations in
+// the same order, no fused multiply-add), so a lane gives the bits candidateTime gives. Both states are extrapolated
+// to the later clock tr, one of them by zero, which leaves it unchanged (x + (v + g/2 0) 0 = x), as candidateTime's
+// two branches do. The tests a lane can fail cheaply (receding, b >= 0; root beyond the best event so far by the
+// lower bound c / (-2 b)) are taken for all four at once; most batches end there. A lane that needs more than the
+// quadratic (a frozen partner, a root before now, no relative speed) goes to candidateTime. The lanes are then
+// offered to best in order, as the scalar loop would: the result is the minimum of (time, code), which does not
+// depend on the order, and a skip against the best time before the batch (not the best within it) only skips
+// less.
+template <int D>
+[[gnu::always_inline]] inline void EdmEngine<D>::candidates4(const ScanState& sc, const Hot& hs, std::uint32_t s,
+                                                             const Batch& bt, std::uint32_t wsPacked,
+                                                             const Shift* plainBase, double now, Candidate& best,
+                                                             std::uint32_t& bestJ) const {
+    using V = Lanes::Values;
+    const std::uint32_t* j = bt.j;
+    // Plain: no candidate needs an image shift (the same wraps as s, a cell that crosses no box face): most batches.
+    const bool plain = ((bt.wrap[0] ^ wsPacked) | (bt.wrap[1] ^ wsPacked) | (bt.wrap[2] ^ wsPacked) |
+                        (bt.wrap[3] ^ wsPacked)) == 0 &&
+                       bt.base[0] == plainBase && bt.base[1] == plainBase && bt.base[2] == plainBase &&
+                       bt.base[3] == plainBase;
+    V X[D], Vv[D], T, R;
+    if constexpr (D == 3) {
+        Lanes a[4], b[4];
+        transpose4(hot_[j[0]].x.c.data(), hot_[j[1]].x.c.data(), hot_[j[2]].x.c.data(), hot_[j[3]].x.c.data(), a);
+        transpose4(hot_[j[0]].v.c.data(), hot_[j[1]].v.c.data(), hot_[j[2]].v.c.data(), hot_[j[3]].v.c.data(), b);
+        for (int k = 0; k < 3; ++k) {
+            X[k] = a[k].v;
+            Vv[k] = b[k].v;
+        }
+        T = a[3].v;
+        R = b[3].v;
+    } else {
+        const Hot &h0 = hot_[j[0]], &h1 = hot_[j[1]], &h2 = hot_[j[2]], &h3 = hot_[j[3]];
+#ifdef __AVX__
+        // 2D: (x0, x1, t, v0) and (v1, r) of each record (48 bytes, 16-aligned), transposed into lanes.
+        const __m256d a0 = _mm256_loadu_pd(h0.x.c.data()), a1 = _mm256_loadu_pd(h1.x.c.data()),
+                      a2 = _mm256_loadu_pd(h2.x.c.data()), a3 = _mm256_loadu_pd(h3.x.c.data());
+        const __m256d lo01 = _mm256_unpacklo_pd(a0, a1), hi01 = _mm256_unpackhi_pd(a0, a1);
+        const __m256d lo23 = _mm256_unpacklo_pd(a2, a3), hi23 = _mm256_unpackhi_pd(a2, a3);
+        X[0] = _mm256_permute2f128_pd(lo01, lo23, 0x20);
+        X[1] = _mm256_permute2f128_pd(hi01, hi23, 0x20);
+        T = _mm256_permute2f128_pd(lo01, lo23, 0x31);
+        Vv[0] = _mm256_permute2f128_pd(hi01, hi23, 0x31);
+        const __m256d b02 = _mm256_set_m128d(_mm_load_pd(h2.v.c.data() + 1), _mm_load_pd(h0.v.c.data() + 1));
+        const __m256d b13 = _mm256_set_m128d(_mm_load_pd(h3.v.c.data() + 1), _mm_load_pd(h1.v.c.data() + 1));
+        Vv[1] = _mm256_unpacklo_pd(b02, b13);
+        R = _mm256_unpackhi_pd(b02, b13);
+#else
+        for (int k = 0; k < D; ++k) {
+            X[k] = V{h0.x[k], h1.x[k], h2.x[k], h3.x[k]};
+            Vv[k] = V{h0.v[k], h1.v[k], h2.v[k], h3.v[k]};
+        }
+        T = V{h0.t, h1.t, h2.t, h3.t};
+        R = V{h0.r, h1.r, h2.r, h3.r};
+#endif
+    }
+    const V zero = {0, 0, 0, 0};
+    const V tsL = sc.t;
+    const auto frozenL = T == kNever;
+    const V Tm = frozenL ? tsL : T;  // a frozen lane goes to candidateTime; no infinities in the arithmetic
+    const V tr = tsL < Tm ? Tm : tsL;
+    const V da = tr - tsL, db = tr - Tm;
+    // Image shifts (base + wraps of the candidate) in box lengths, unless the batch is plain (all zero; the
+    // scalar form adds 0 L, which changes at most the sign of a zero difference).
+    std::int32_t m[D][4];
+    if (!plain) {
+        for (int l = 0; l < 4; ++l) {
+            const Shift w = wrapsOf(bt.wrap[l]);
+            for (int k = 0; k < D; ++k) m[k][l] = (*bt.base[l])[k] + w[k];
+        }
+    }
+    V r[D], v[D];
+    for (int k = 0; k < D; ++k) {
+        const V xa = sc.x[k] + (sc.v[k] + sc.gh[k] * da) * da;
+        const V xb = X[k] + (Vv[k] + sc.gh[k] * db) * db;
+        r[k] = xa - xb;
+        if (!plain) {
+            LaneIndex mk;
+            __builtin_memcpy(&mk, m[k], sizeof mk);
+            r[k] += __builtin_convertvector(mk, V) * sc.len[k];
+        }
+        v[k] = (sc.v[k] + sc.g[k] * da) - (Vv[k] + sc.g[k] * db);
+    }
+    V b = r[0] * v[0], r2 = r[0] * r[0], v2 = v[0] * v[0];
+    for (int k = 1; k < D; ++k) {
+        b += r[k] * v[k];
+        r2 += r[k] * r[k];
+        v2 += v[k] * v[k];
+    }
+    const V sigma = sc.r + R;
+    const V c = r2 - sigma * sigma;
+    const V left = best.time - tr;
+    const auto far = (c > 0) & (c > -2.0 * b * left * (1 + 1e-12));
+    const auto todo = (b < 0) & ~far & ~frozenL;
+    // Nothing to offer: every lane receding or beyond the best event (then kNever is not better than it either).
+    if (best.time < kNever && !anyLane(todo | frozenL)) return;
+    // f(t) = c + 2 b t + v2 t^2 with f2 = 2 v2 > 0 and f1 = 2 b < 0 (firstRootFalling's second branch)
+    const V f1 = 2.0 * b, f2 = 2.0 * v2;
+    const V arg = f1 * f1 - 2.0 * f2 * c;
+    V sq;
+#ifdef __AVX__
+    sq = _mm256_sqrt_pd(arg > 0 ? arg : zero);
+#else
+    for (int l = 0; l < 4; ++l) sq[l] = std::sqrt(arg[l] > 0 ? arg[l] : 0.0);
+#endif
+    const V q = (2.0 * c) / (-f1 + sq);
+    const V root = tr + (0 < q ? q : zero);
+    const auto hit = todo & (arg > 0) & (f2 > 0);
+    const auto special = frozenL | (todo & ~(f2 > 0)) | (hit & (root < now));
+    const V t = hit ? root : zero + kNever;
+    for (int l = 0; l < 4; ++l) {
+        double tl = t[l];
+        if (special[l]) {
+            Shift ml;
+            const Shift w = wrapsOf(bt.wrap[l]);
+            for (int k = 0; k < D; ++k) ml[k] = (*bt.base[l])[k] + w[k];
+            tl = candidateTime(hs, s, j[l], ml, now, best.time);
+        }
+        const std::uint32_t code = (kPair << kTypeShift) | j[l];
+        if (best.better(tl, code)) {
+            best = {tl, code, 0};
+            bestJ = j[l];
+        }
+    }
+}
+
 // Predicts the next event of slot s at time now: the earliest of its cell exit, its wall collisions and its
 // collisions with the particles of the 3^D neighbour cells. After a cell crossing (axis >= 0, dir = +-1) with a
 // still valid earlier result in rec_[s].coll, only the newly adjacent cells are scanned: the others were scanned
@@ -496,16 +663,17 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
     queue_.prefetchPath(s);
     const Hot& hs = hot_[s];
     const Shift ws = wrapsOf(link_[s].wrap);
-    // Cell coordinates, the faces s can leave through, and the neighbour cells per axis. The exit is computed from
-    // the state at "now": from the older stored state the quadratic can also find a crossing that already
-    // happened (through a face and back under gravity).
+    // Cell coordinates and the faces s can leave through. The exit is computed from the state at "now": from the
+    // older stored state the quadratic can also find a crossing that already happened (through a face and back
+    // under gravity).
     const Vec<D> xNow = posAt(hs, now), vNow = velAt(hs, now);
     Candidate cross;
-    std::array<std::array<int, 3>, D> nbr, omega;
-    std::array<int, D> nbrCount, cc;
+    std::array<int, D> cc;
+    bool interior = true;
     for (int k = 0; k < D; ++k) {
         const int c = static_cast<int>((rec_[s].cell / stride_[k]) % static_cast<std::uint32_t>(nCell_[k]));
         cc[k] = c;
+        interior = interior && c >= 1 && c <= nCell_[k] - 2;
         const bool per = dom.periodic[k];
         const double lo = (c == 0 && !per) ? -kNever : dom.lo[k] + c * cellW_[k];
         const double hi = (c == nCell_[k] - 1 && !per) ? kNever : dom.lo[k] + (c + 1) * cellW_[k];
@@ -515,24 +683,6 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
             const std::uint32_t code = (kCell << kTypeShift) | static_cast<std::uint32_t>(2 * k + (ex.up ? 1 : 0));
             if (cross.better(t, code)) cross = {t, code, 0};
         }
-        int m = 0;
-        for (int o = -1; o <= 1; ++o) {
-            if (k == axis && o != dir) continue;
-            int cn = c + o, om = 0;
-            if (cn < 0) {
-                if (!per) continue;
-                cn += nCell_[k];
-                om = -1;
-            } else if (cn >= nCell_[k]) {
-                if (!per) continue;
-                cn -= nCell_[k];
-                om = 1;
-            }
-            nbr[k][m] = cn;
-            omega[k][m] = om;
-            ++m;
-        }
-        nbrCount[k] = m;
     }
     Candidate best;
     if (axis >= 0) {
@@ -544,113 +694,133 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
             if (best.better(t, code)) best = {t, code, 0};
         }
     }
-    // Neighbour cells. Their list heads are loaded first and the first member of each list prefetched, so that the
-    // cache misses overlap instead of following each other. A cell away from the box faces takes its neighbours
-    // from a table of index offsets; one at a face (open or periodic) goes through the per-axis lists.
+    // Neighbour cells: the heads of those that are not empty, loaded first and their first members prefetched, so
+    // that the cache misses overlap instead of following each other. A cell away from the box faces takes its
+    // neighbours from a table of index offsets; one at a face (open or periodic) goes through the per-axis lists,
+    // with the image shift of each cell (base: minus s's wraps, minus the box lengths crossed).
     constexpr int kMaxCells = D == 3 ? 27 : 9;
     std::uint32_t heads[kMaxCells];
     Shift bases[kMaxCells];
+    bool plainCell[kMaxCells];  // base = -ws: no box length crossed
     int nc = 0;
-    bool interior = true;
-    for (int k = 0; k < D; ++k) interior = interior && cc[k] >= 1 && cc[k] <= nCell_[k] - 2;
-    const Shift negWs = [&] {
-        Shift r;
-        for (int k = 0; k < D; ++k) r[k] = -ws[k];
-        return r;
-    }();
+    Shift negWs;
+    for (int k = 0; k < D; ++k) negWs[k] = -ws[k];
     if (interior) {
-        const std::vector<std::int32_t>& deltas = axis < 0 ? deltaFull_ : deltaSide_[2 * axis + (dir > 0 ? 1 : 0)];
-        const std::uint32_t c0 = rec_[s].cell;
-        for (const std::int32_t dl : deltas) heads[nc++] = head_[c0 + static_cast<std::uint32_t>(dl)];
+        const std::uint32_t* hc = &head_[rec_[s].cell];
+        auto load = [&](const auto& deltas) {
+            for (const std::int32_t dl : deltas) {
+                const std::uint32_t h = hc[dl];
+                heads[nc] = h;
+                nc += h != kNil;
+            }
+        };
+        if (axis < 0)
+            load(deltaFull_);
+        else
+            load(deltaSide_[2 * axis + (dir > 0 ? 1 : 0)]);
     } else {
+        std::array<std::array<int, 3>, D> nbr, omega;
+        std::array<int, D> nbrCount;
         bool any = true;
-        for (int k = 0; k < D; ++k) any = any && nbrCount[k] > 0;
+        for (int k = 0; k < D; ++k) {
+            const bool per = dom.periodic[k];
+            int m = 0;
+            for (int o = -1; o <= 1; ++o) {
+                if (k == axis && o != dir) continue;
+                int cn = cc[k] + o, om = 0;
+                if (cn < 0) {
+                    if (!per) continue;
+                    cn += nCell_[k];
+                    om = -1;
+                } else if (cn >= nCell_[k]) {
+                    if (!per) continue;
+                    cn -= nCell_[k];
+                    om = 1;
+                }
+                nbr[k][m] = cn;
+                omega[k][m] = om;
+                ++m;
+            }
+            nbrCount[k] = m;
+            any = any && m > 0;
+        }
         std::array<int, D> at{};
         while (any) {
             std::uint32_t cellIndex = 0;
+            bool plain = true;
             for (int k = 0; k < D; ++k) {
                 cellIndex += static_cast<std::uint32_t>(nbr[k][at[k]]) * stride_[k];
                 bases[nc][k] = -ws[k] - omega[k][at[k]];
+                plain = plain && omega[k][at[k]] == 0;
             }
-            heads[nc++] = head_[cellIndex];
+            const std::uint32_t h = head_[cellIndex];
+            heads[nc] = h;
+            plainCell[nc] = plain;
+            nc += h != kNil;
             int k = 0;
             while (k < D && ++at[k] == nbrCount[k]) at[k++] = 0;
             if (k == D) break;
         }
     }
     for (int q = 0; q < nc; ++q) {
-        if (heads[q] == kNil) continue;
         __builtin_prefetch(&hot_[heads[q]]);
         __builtin_prefetch(&link_[heads[q]]);
     }
     queue_.prefetchRivals(s);
-    // The canonical form of pairTime, written out for speed: the older of the two states is extrapolated to the
-    // other's clock (an extrapolation by zero leaves a state unchanged, so skipping it gives the same bits).
-    // Candidates later than the best pair or wall event so far are skipped before the square root, but never
-    // because they are later than the cell exit: rec_[s].coll must stay the earliest over all neighbours for the
-    // partial scans after a crossing.
-    const double ts = hs.t;
-    double gHalf[D];
-    for (int k = 0; k < D; ++k) gHalf[k] = 0.5 * g_[k];
-    for (int q = 0; q < nc; ++q) {
-        const Shift& base = interior ? negWs : bases[q];
-        for (std::uint32_t j = heads[q]; j != kNil;) {
-            const Link& lj = link_[j];
-            const std::uint32_t nextJ = lj.next;
-            if (j != s) {
-                const Hot& hj = hot_[j];
-                const Shift wj = wrapsOf(lj.wrap);
-                double t = kNever;
-                if (hj.t == kNever) {
-                    Shift m;
-                    for (int k = 0; k < D; ++k) m[k] = base[k] + wj[k];
-                    t = pairTime(s, j, m, now, best.time);
-                } else {
-                    double r[D], v[D], tr;
-                    if (hj.t <= ts) {
-                        tr = ts;
-                        const double db = ts - hj.t;
-                        for (int k = 0; k < D; ++k) {
-                            const double xb = hj.x[k] + (hj.v[k] + gHalf[k] * db) * db;
-                            r[k] = (hs.x[k] - xb) + (base[k] + wj[k]) * boxLen_[k];
-                            v[k] = hs.v[k] - (hj.v[k] + g_[k] * db);
-                        }
-                    } else {
-                        tr = hj.t;
-                        const double da = hj.t - ts;
-                        for (int k = 0; k < D; ++k) {
-                            const double xa = hs.x[k] + (hs.v[k] + gHalf[k] * da) * da;
-                            r[k] = (xa - hj.x[k]) + (base[k] + wj[k]) * boxLen_[k];
-                            v[k] = (hs.v[k] + g_[k] * da) - hj.v[k];
-                        }
-                    }
-                    double b = 0;
-                    for (int k = 0; k < D; ++k) b += r[k] * v[k];
-                    if (b < 0) {
-                        const double sigma = hs.r + hj.r;
-                        double r2 = 0;
-                        for (int k = 0; k < D; ++k) r2 += r[k] * r[k];
-                        const double c = r2 - sigma * sigma;
-                        // Lower bound of the root: c / (-2 b). Beyond the best event so far: no sqrt, no division.
-                        const double left = best.time - tr;
-                        if (!(c > 0 && c > -2 * b * left * (1 + 1e-12))) {
-                            double v2 = 0;
-                            for (int k = 0; k < D; ++k) v2 += v[k] * v[k];
-                            t = tr + firstRootFalling(c, 2 * b, 2 * v2);
-                            if (t < now) {
-                                Shift m;
-                                for (int k = 0; k < D; ++k) m[k] = base[k] + wj[k];
-                                t = pairTimeFromNow(s, j, m, now);
-                            }
-                        }
-                    }
-                }
-                const std::uint32_t code = (kPair << kTypeShift) | j;
-                if (best.better(t, code)) best = {t, code, lj.count};
+    // The candidates are collected four at a time and evaluated side by side (candidates4): the arithmetic of
+    // candidateTime lane by lane. Candidates later than the best pair or wall event so far are skipped before the
+    // square root, but never because they are later than the cell exit: rec_[s].coll must stay the earliest over
+    // all neighbours for the partial scans after a crossing. A batch is plain when no candidate needs an image
+    // shift (same wraps as s, a cell that crosses no box face): most are. The lists are walked first (only the
+    // links), in chunks of at most kChunk candidates (a cell of a coarse grid can hold many).
+    constexpr int kChunk = 64;
+    const ScanState sc = scanState(hs);
+    const std::uint32_t wsPacked = link_[s].wrap;
+    std::uint32_t cand[kChunk + 4], wrap[kChunk + 4];
+    const Shift* base[kChunk + 4];
+    std::uint32_t bestJ = kNil;
+    // Evaluates the candidates of the buffer in fours (all: also the last one to three); returns how many are left.
+    auto evaluate = [&](int n, bool all) {
+        int i = 0;
+        for (; i + 4 <= n; i += 4)
+            candidates4(sc, hs, s, Batch{cand + i, wrap + i, base + i}, wsPacked, &negWs, now, best, bestJ);
+        if (all && i < n) {
+            // The last lanes repeat the first candidate: the same time and code, never better than itself.
+            for (int l = n; l < i + 4; ++l) {
+                cand[l] = cand[i];
+                wrap[l] = wrap[i];
+                base[l] = base[i];
             }
-            j = nextJ;
+            candidates4(sc, hs, s, Batch{cand + i, wrap + i, base + i}, wsPacked, &negWs, now, best, bestJ);
+            i = n;
+        }
+        for (int l = i; l < n; ++l) {  // fewer than four left: to the front
+            cand[l - i] = cand[l];
+            wrap[l - i] = wrap[l];
+            base[l - i] = base[l];
+        }
+        return n - i;
+    };
+    int n = 0;
+    for (int q = 0; q < nc; ++q) {
+        const Shift* b = (interior || plainCell[q]) ? &negWs : &bases[q];
+        std::uint32_t j = heads[q];
+        for (;;) {
+            do {
+                const Link& lj = link_[j];
+                if (lj.next != kNil) __builtin_prefetch(&hot_[lj.next]);
+                cand[n] = j;
+                wrap[n] = lj.wrap;
+                base[n] = b;
+                n += j != s;
+                j = lj.next;
+            } while (j != kNil && n < kChunk);
+            if (j == kNil) break;
+            n = evaluate(n, false);
         }
     }
+    evaluate(n, true);
+    if (bestJ != kNil) best.stamp = link_[bestJ].count;
     setPending(s, best, cross);
 }
 
@@ -866,21 +1036,40 @@ void EdmEngine<D>::predictShell(std::uint32_t s, double now) {
         const std::uint32_t code = (kWall << kTypeShift) | static_cast<std::uint32_t>(w);
         if (best.better(t, code)) best = {t, code, 0};
     }
+    // Four partners at a time, as in the cell scan (candidates4); the image of a list entry is a base per entry.
+    const ScanState sc = scanState(hs);
+    const std::uint32_t zeroWraps = packWraps(Shift{});
+    const Shift none{};
+    std::uint32_t cand[4], wrap[4] = {zeroWraps, zeroWraps, zeroWraps, zeroWraps};
+    Shift bases[4];
+    const Shift* base[4];
+    int nb = 0;
     std::uint32_t bestJ = kNil;
     for (std::uint32_t q = 1; q <= count; ++q) {
         const std::uint32_t j = a[q] & kSlotMask;
-        Shift m{};
+        cand[nb] = j;
+        base[nb] = &none;
         if (periodic_) {
             const std::uint32_t image = a[q] >> kImageShift;
             const Shift wj = wrapsOf(link_[j].wrap);
-            for (int k = 0; k < D; ++k) m[k] = wj[k] - ws[k] - (static_cast<std::int32_t>((image >> (2 * k)) & 3u) - 1);
+            bool zero = true;
+            for (int k = 0; k < D; ++k) {
+                bases[nb][k] = wj[k] - ws[k] - (static_cast<std::int32_t>((image >> (2 * k)) & 3u) - 1);
+                zero = zero && bases[nb][k] == 0;
+            }
+            if (!zero) base[nb] = &bases[nb];
         }
-        const double t = candidateTime(hs, s, j, m, now, best.time);
-        const std::uint32_t code = (kPair << kTypeShift) | j;
-        if (best.better(t, code)) {
-            best = {t, code, 0};
-            bestJ = j;
+        if (++nb == 4) {
+            candidates4(sc, hs, s, Batch{cand, wrap, base}, zeroWraps, &none, now, best, bestJ);
+            nb = 0;
         }
+    }
+    if (nb > 0) {
+        for (int l = nb; l < 4; ++l) {
+            cand[l] = cand[0];
+            base[l] = base[0];
+        }
+        candidates4(sc, hs, s, Batch{cand, wrap, base}, zeroWraps, &none, now, best, bestJ);
     }
     if (bestJ != kNil) best.stamp = link_[bestJ].count;
     setPending(s, best, cross);

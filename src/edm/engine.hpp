@@ -20,7 +20,8 @@ namespace haet {
 
 struct EdmSettings {
     /// Edge of the event grid's cells [m]; 0: the largest particle diameter (with neighbour shells: plus the
-    /// shell). Must not be smaller than that.
+    /// shell), and in a 3D world without gravity (with cell crossings) at least the edge that makes 2.5 cells per
+    /// particle (docs/edm.md). Must not be smaller than the largest diameter (plus the shell).
     double cellSize = 0;
     /// Neighbour shells (docs/edm.md), thickness [in units of the largest diameter]: each particle keeps a list
     /// of the particles it can touch while it stays within half the thickness (per axis) of where its list was
@@ -282,6 +283,24 @@ private:
     void predictShell(std::uint32_t s, double now);
     double candidateTime(const Hot& hs, std::uint32_t s, std::uint32_t j, const Shift& m, double now,
                          double bestTime) const;
+    /// Four candidates of a scan at once (docs/edm.md, "Four candidates at a time"). ScanState: the scanning
+    /// slot's state and the constants, one value per lane. Batch: the candidates' slots, packed wraps and image
+    /// bases (the image shift in box lengths is base + wrapsOf(wrap)); a batch whose wraps all equal wsPacked and
+    /// whose bases are all plainBase (minus the scanning slot's wraps) needs no shift. best (and bestJ, the slot of a
+    /// pair event in it) updated as candidateTime and Candidate::better, one candidate after the other, would.
+    struct ScanState {
+        using V = double __attribute__((vector_size(32)));
+        V x[D], v[D], gh[D], g[D], len[D], t, r;
+    };
+    struct Batch {
+        const std::uint32_t* j;
+        const std::uint32_t* wrap;
+        const Shift* const* base;
+    };
+    ScanState scanState(const Hot& hs) const;
+    [[gnu::always_inline]] inline void candidates4(const ScanState& sc, const Hot& hs, std::uint32_t s, const Batch& bt,
+                                                   std::uint32_t wsPacked, const Shift* plainBase, double now,
+                                                   Candidate& best, std::uint32_t& bestJ) const;
     bool shellsMeet(std::uint32_t s, std::uint32_t j, const Shift& image) const;
     bool linkShell(std::uint32_t s);
     void unlinkShell(std::uint32_t s);
@@ -342,8 +361,9 @@ private:
     EventTree queue_;  // pending event times
     // cell grid (singly linked lists: a crossing walks the old cell's few members to unlink)
     std::vector<std::uint32_t> head_;
-    std::vector<std::int32_t> deltaFull_;                     // neighbour cell offsets (cells away from the faces)
-    std::array<std::vector<std::int32_t>, 2 * D> deltaSide_;  // new neighbours after a crossing
+    static constexpr int kNbrCells = D == 3 ? 27 : 9, kSideCells = D == 3 ? 9 : 3;
+    std::array<std::int32_t, kNbrCells> deltaFull_{};  // neighbour cell offsets (cells away from the faces)
+    std::array<std::array<std::int32_t, kSideCells>, 2 * D> deltaSide_{};  // new neighbours after a crossing
     std::array<int, D> nCell_{};
     std::array<std::uint32_t, D> stride_{};
     Vec<D> cellW_;
