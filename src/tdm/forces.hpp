@@ -86,19 +86,18 @@ struct PairBlock {
     struct Entry {
         Row a, b;
     };
-    /// A touching pair for the law: owner i, partner j, pair slot k, index of the material pair's coefficients.
-    struct Item {
-        std::uint32_t owner, partner, slot, coeff;
-    };
-    /// The separation d = x_i - x_j (+ shift) and the spring of a touching pair.
-    struct Rows {
-        Row sep, spring;
-    };
-    // The touching pairs the law evaluates (list index m), padded to a multiple of 4 (one array each, so that
-    // the contact tests write through few pointers), and (threaded) the entry each fills.
-    std::vector<Item> items;
-    std::vector<Rows> rows;
+    // The touching pairs the law evaluates (list index m), padded to a multiple of 4, each field in an array of
+    // its own (the lanes load four at once, and the contact tests store four at once): owner i, partner j, pair
+    // slot k (whose spring stays in the pair list), the separation d = x_i - x_j (+ shift) component by component,
+    // and (threaded) the entry each fills.
+    std::vector<std::uint32_t> owner, partner, slot;
+    std::vector<double> sep[D];
     std::vector<std::uint32_t> entry;
+    // The four-at-a-time contact tests (findTouchingLanes): the owner of each listed pair of the block, and per
+    // group of four listed pairs the mask of those touching and the number of touching pairs before the group.
+    std::vector<std::uint32_t> slotOwner;
+    std::vector<std::uint8_t> groupMask;
+    std::vector<std::uint32_t> groupBefore;
     // The entries of the block's owners, in pair order: evaluated pairs and (threaded) cross pairs.
     std::vector<Entry> out;
     std::vector<std::uint32_t> outPartner;  ///< j of each entry, kNoPartner for a cross pair
@@ -108,10 +107,15 @@ struct PairBlock {
     /// Room for a block of `pairs` listed pairs.
     void fit(std::size_t pairs) {
         const std::size_t need = std::max<std::size_t>(pairs, kPairs) + 4;
-        if (items.size() >= need) return;
-        items.resize(need);
-        rows.resize(need);
+        if (owner.size() >= need) return;
+        owner.resize(need);
+        partner.resize(need);
+        slot.resize(need);
+        for (auto& c : sep) c.resize(need);
         entry.resize(need);
+        slotOwner.resize(need);
+        groupMask.resize(need / 4 + 2);
+        groupBefore.resize(need / 4 + 2);
         outPartner.resize(need);
         out.resize(need);
         ownerEnd.resize(kOwners + 1);
@@ -321,30 +325,52 @@ inline KernelVec<N> rowVec(const double* row) {
     return kernelVec(a);
 }
 
-/// Pass (1) over the block's particles [b0, b1): the contact test of each listed pair, without a branch on its
-/// outcome: the pair is written at the end of the list of touching pairs, which grows by one when it touches; its
-/// spring moves from the pair list to the block (the list keeps a zero, right for a pair not touching). Cross
-/// pairs (kCross, partner >= e) come from their slots, cross[c...]. Returns the number of touching pairs.
+/// The contact test of listed pair k (owner i at xi with radius ri, partner j), written at place nl of the block's
+/// list of touching pairs whatever its outcome (the list grows by one when it touches). The pair's spring stays in
+/// the pair list; a pair not touching has it cleared there (by a mask, without a branch). Returns whether the pair
+/// touches.
+template <int D, class Tangential>
+[[gnu::always_inline]] inline bool testPair(const PairInputs<D>& in, PairBlock<D>& bl, std::uint32_t i,
+                                            const KernelVec<D>& xi, double ri, std::uint32_t k, std::uint32_t j,
+                                            std::uint32_t nl) {
+    KernelVec<D> d = xi - kernelVec(in.x[j]);
+    if (in.shift[k] != PairList<D>::kNoShift) d += kernelVec(in.shiftVec[in.shift[k]]);
+    const double rsum = ri + in.radius[j];
+    const double dist2 = norm2(d);
+    bl.owner[nl] = i;
+    bl.partner[nl] = j;
+    bl.slot[nl] = k;
+    const Vec<D> ds = storedVec(d);
+    for (int c = 0; c < D; ++c) bl.sep[c][nl] = ds[c];
+    const bool touching = !(dist2 >= rsum * rsum);  // a NaN counts as touching: it must be seen
+    if constexpr (Tangential::kHasHistory) {
+        double* h = in.history[k].c.data();
+        const std::uint64_t keep = std::uint64_t{0} - std::uint64_t{touching};
+        for (int c = 0; c < D; ++c) {
+            std::uint64_t b;
+            __builtin_memcpy(&b, h + c, 8);
+            b &= keep;
+            __builtin_memcpy(h + c, &b, 8);
+        }
+    }
+    return touching;
+}
+
+/// Pass (1) over the block's particles [b0, b1), one pair at a time: the contact test of each listed pair, without
+/// a branch on its outcome (testPair). Cross pairs (kCross, partner >= e) come from their slots, cross[c...].
+/// Returns the number of touching pairs. The twin of findTouchingLanes, and the threaded path's.
 template <int D, class Tangential, bool kCross>
 [[gnu::noinline]] std::uint32_t findTouching(const PairInputs<D>& in, const std::uint32_t* first, std::size_t b0,
                                              std::size_t b1, std::size_t e, const CrossPair<D>* cross,
                                              std::size_t& c, PairBlock<D>& bl) {
     using Block = PairBlock<D>;
-    const Vec<D>* x = in.x;
-    const double* radius = in.radius;
-    const std::uint16_t* material = in.material;
     const std::uint32_t* partner = in.partner;
-    const std::uint8_t* shift = in.shift;
-    Vec<D>* history = in.history;
-    typename Block::Item* items = bl.items.data();
-    typename Block::Rows* rows = bl.rows.data();
     std::uint32_t* entry = bl.entry.data();
     std::uint32_t* outPartner = bl.outPartner.data();
     std::uint32_t nl = 0, ne = 0, last = 0;
     for (std::size_t i = b0; i < b1; ++i) {
-        const KernelVec<D> xi = kernelVec(x[i]);
-        const double ri = radius[i];
-        const std::uint32_t row = std::uint32_t{material[i]} * static_cast<std::uint32_t>(in.nMaterials);
+        const KernelVec<D> xi = kernelVec(in.x[i]);
+        const double ri = in.radius[i];
         for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) {
             const std::uint32_t j = partner[k];
             if constexpr (kCross) {
@@ -361,21 +387,11 @@ template <int D, class Tangential, bool kCross>
                 }
             }
             last = std::max(last, j);
-            KernelVec<D> d = xi - kernelVec(x[j]);
-            if (shift[k] != PairList<D>::kNoShift) d += kernelVec(in.shiftVec[shift[k]]);
-            const double rsum = ri + radius[j];
-            const double dist2 = norm2(d);
-            items[nl] = {static_cast<std::uint32_t>(i), j, k, row + material[j]};
-            storeRow<D>(rows[nl].sep.c, d);
-            if constexpr (Tangential::kHasHistory) {
-                storeRow<D>(rows[nl].spring.c, kernelVec(history[k]));
-                history[k] = Vec<D>::zero();
-            }
             if constexpr (kCross) {
                 entry[nl] = ne;
                 outPartner[ne] = j;
             }
-            const bool touching = !(dist2 >= rsum * rsum);  // a NaN counts as touching: it must be seen
+            const bool touching = testPair<D, Tangential>(in, bl, static_cast<std::uint32_t>(i), xi, ri, k, j, nl);
             nl += touching;
             ne += touching;
         }
@@ -385,6 +401,151 @@ template <int D, class Tangential, bool kCross>
     return nl;
 }
 
+#ifdef __AVX2__
+/// For each mask of four lanes, its set lanes in order (then zeros): the compaction of four pairs to the touching
+/// ones: i32 moves four 32-bit numbers, i64 four doubles (as pairs of 32-bit halves).
+struct CompactTables {
+    alignas(16) std::int32_t i32[16][4];
+    alignas(32) std::int32_t i64[16][8];
+    constexpr CompactTables() : i32{}, i64{} {
+        for (int m = 0; m < 16; ++m) {
+            int n = 0;
+            for (int l = 0; l < 4; ++l)
+                if (m >> l & 1) {
+                    i32[m][n] = l;
+                    i64[m][2 * n] = 2 * l;
+                    i64[m][2 * n + 1] = 2 * l + 1;
+                    ++n;
+                }
+        }
+    }
+};
+inline constexpr CompactTables kCompact{};
+
+/// Rows idx[0..3] of a (D doubles each) as D lanes: lane l of out[c] is a[idx[l]][c].
+template <int D>
+[[gnu::always_inline]] inline void loadTransposed(const Vec<D>* a, const std::uint32_t* idx, __m256d* out) {
+    if constexpr (D == 3) {
+        // A masked load reads the three doubles only (never past the array's end).
+        const __m256i m = _mm256_setr_epi64x(-1, -1, -1, 0);
+        const __m256d r0 = _mm256_maskload_pd(a[idx[0]].c.data(), m), r1 = _mm256_maskload_pd(a[idx[1]].c.data(), m);
+        const __m256d r2 = _mm256_maskload_pd(a[idx[2]].c.data(), m), r3 = _mm256_maskload_pd(a[idx[3]].c.data(), m);
+        const __m256d ab0 = _mm256_unpacklo_pd(r0, r1), ab1 = _mm256_unpackhi_pd(r0, r1);
+        const __m256d cd0 = _mm256_unpacklo_pd(r2, r3), cd1 = _mm256_unpackhi_pd(r2, r3);
+        out[0] = _mm256_permute2f128_pd(ab0, cd0, 0x20);
+        out[1] = _mm256_permute2f128_pd(ab1, cd1, 0x20);
+        out[2] = _mm256_permute2f128_pd(ab0, cd0, 0x31);
+    } else {
+        const __m256d r02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(a[idx[0]].c.data())),
+                                                 _mm_loadu_pd(a[idx[2]].c.data()), 1);
+        const __m256d r13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(a[idx[1]].c.data())),
+                                                 _mm_loadu_pd(a[idx[3]].c.data()), 1);
+        out[0] = _mm256_unpacklo_pd(r02, r13);
+        out[1] = _mm256_unpackhi_pd(r02, r13);
+    }
+}
+
+/// Pass (1) over the block's particles [b0, b1) (one thread: no cross pairs), four listed pairs at a time in AVX
+/// lanes, taken in slot order across owners: the four contact tests give a mask; the touching pairs' fields are
+/// compacted by it (a table of lane permutations) and stored at the end of the list, which grows by the mask's
+/// population; the springs of the pairs not touching are cleared by the mask. A group with a periodic shift, and
+/// the last listed pairs (fewer than four), go one pair at a time (testPair). Same list as findTouching.
+template <int D, class Tangential>
+[[gnu::noinline]] std::uint32_t findTouchingLanes(const PairInputs<D>& in, const std::uint32_t* first,
+                                                  std::size_t b0, std::size_t b1, PairBlock<D>& bl) {
+    const std::uint32_t k0 = first[b0], n = first[b1] - k0;
+    std::uint32_t* own = bl.slotOwner.data();
+    for (std::size_t i = b0; i < b1; ++i)
+        for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) own[k - k0] = static_cast<std::uint32_t>(i);
+    const std::uint32_t* partner = in.partner;
+    std::uint8_t* gmask = bl.groupMask.data();
+    std::uint32_t* before = bl.groupBefore.data();
+    std::uint32_t* outOwner = bl.owner.data();
+    std::uint32_t* outPartner = bl.partner.data();
+    std::uint32_t* outSlot = bl.slot.data();
+    double* sep[D];
+    for (int c = 0; c < D; ++c) sep[c] = bl.sep[c].data();
+    constexpr std::uint32_t kNoShift4 = 0x01010101u * PairList<D>::kNoShift;
+    __m128i last = _mm_setzero_si128();
+    std::uint32_t nl = 0, g = 0;
+    auto onePair = [&](std::uint32_t k, unsigned l, unsigned& m) {
+        const std::uint32_t i = own[k - k0], j = partner[k];
+        last = _mm_max_epu32(last, _mm_cvtsi32_si128(static_cast<int>(j)));
+        const bool t = testPair<D, Tangential>(in, bl, i, kernelVec(in.x[i]), in.radius[i], k, j, nl);
+        m |= unsigned{t} << l;
+        nl += t;
+    };
+    for (; 4 * g + 4 <= n; ++g) {
+        const std::uint32_t k = k0 + 4 * g;
+        before[g] = nl;
+        std::uint32_t sh;
+        __builtin_memcpy(&sh, in.shift + k, 4);
+        if (sh != kNoShift4) {
+            unsigned m = 0;
+            for (unsigned l = 0; l < 4; ++l) onePair(k + l, l, m);
+            gmask[g] = static_cast<std::uint8_t>(m);
+            continue;
+        }
+        const std::uint32_t* ii = own + 4 * g;
+        const std::uint32_t* jj = partner + k;
+        __m256d xi[D], xj[D];
+        loadTransposed<D>(in.x, ii, xi);
+        loadTransposed<D>(in.x, jj, xj);
+        const __m256d ri = _mm256_setr_pd(in.radius[ii[0]], in.radius[ii[1]], in.radius[ii[2]], in.radius[ii[3]]);
+        const __m256d rj = _mm256_setr_pd(in.radius[jj[0]], in.radius[jj[1]], in.radius[jj[2]], in.radius[jj[3]]);
+        __m256d d[D];
+        for (int c = 0; c < D; ++c) d[c] = _mm256_sub_pd(xi[c], xj[c]);
+        __m256d dist2 = _mm256_mul_pd(d[0], d[0]);  // as norm2: ((d0 d0 + d1 d1) + d2 d2)
+        for (int c = 1; c < D; ++c) dist2 = _mm256_add_pd(dist2, _mm256_mul_pd(d[c], d[c]));
+        const __m256d rsum = _mm256_add_pd(ri, rj);
+        const __m256d touch = _mm256_cmp_pd(dist2, _mm256_mul_pd(rsum, rsum), _CMP_NGE_UQ);  // NaN: touching
+        const unsigned m = static_cast<unsigned>(_mm256_movemask_pd(touch));
+        gmask[g] = static_cast<std::uint8_t>(m);
+        const __m256i p64 = _mm256_load_si256(reinterpret_cast<const __m256i*>(kCompact.i64[m]));
+        const __m128i p32 = _mm_load_si128(reinterpret_cast<const __m128i*>(kCompact.i32[m]));
+        for (int c = 0; c < D; ++c)
+            _mm256_storeu_pd(sep[c] + nl, _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(d[c]), p64)));
+        const __m128i vi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ii));
+        const __m128i vj = _mm_loadu_si128(reinterpret_cast<const __m128i*>(jj));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(outOwner + nl),
+                         _mm_castps_si128(_mm_permutevar_ps(_mm_castsi128_ps(vi), p32)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(outPartner + nl),
+                         _mm_castps_si128(_mm_permutevar_ps(_mm_castsi128_ps(vj), p32)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(outSlot + nl),
+                         _mm_add_epi32(_mm_set1_epi32(static_cast<int>(k)), p32));
+        last = _mm_max_epu32(last, vj);
+        if constexpr (Tangential::kHasHistory) {
+            // Each lane's mask over its pair's D doubles of the spring (bitwise: a kept spring keeps its bits).
+            double* h = in.history[k].c.data();
+            if constexpr (D == 3) {
+                _mm256_storeu_pd(h, _mm256_and_pd(_mm256_loadu_pd(h), _mm256_permute4x64_pd(touch, 0x40)));
+                _mm256_storeu_pd(h + 4, _mm256_and_pd(_mm256_loadu_pd(h + 4), _mm256_permute4x64_pd(touch, 0xA5)));
+                _mm256_storeu_pd(h + 8, _mm256_and_pd(_mm256_loadu_pd(h + 8), _mm256_permute4x64_pd(touch, 0xFE)));
+            } else {
+                _mm256_storeu_pd(h, _mm256_and_pd(_mm256_loadu_pd(h), _mm256_permute4x64_pd(touch, 0x50)));
+                _mm256_storeu_pd(h + 4, _mm256_and_pd(_mm256_loadu_pd(h + 4), _mm256_permute4x64_pd(touch, 0xFA)));
+            }
+        }
+        nl += static_cast<std::uint32_t>(__builtin_popcount(m));
+    }
+    // The last pairs, and a closing group that the owners' ends below may point into.
+    before[g] = nl;
+    unsigned m = 0;
+    for (std::uint32_t k = k0 + 4 * g, l = 0; k < k0 + n; ++k, ++l) onePair(k, l, m);
+    gmask[g] = static_cast<std::uint8_t>(m);
+    // Owner b0 + q's pairs end at its slot end s: the touching pairs before s.
+    for (std::size_t i = b0; i < b1; ++i) {
+        const std::uint32_t s = first[i + 1] - k0;
+        bl.ownerEnd[i - b0] = before[s / 4] + static_cast<std::uint32_t>(
+                                                  __builtin_popcount(gmask[s / 4] & ((1u << (s % 4)) - 1)));
+    }
+    last = _mm_max_epu32(last, _mm_shuffle_epi32(last, 0x4E));
+    last = _mm_max_epu32(last, _mm_shuffle_epi32(last, 0xB1));
+    bl.reach = std::max<std::size_t>(std::size_t{static_cast<std::uint32_t>(_mm_cvtsi128_si32(last))} + 1, b1);
+    return nl;
+}
+#endif
+
 /// Pass (2): the law on the block's touching pairs [0, nl) (nl a multiple of 4 when kLanes): their springs go
 /// back to the pair list, their contributions to the block's entries.
 template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
@@ -392,33 +553,31 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
     using Row = typename PairBlock<D>::Row;
     using Entry = typename PairBlock<D>::Entry;
     constexpr int A = kAngDim<D>;
-    const typename PairBlock<D>::Item* items = bl.items.data();
-    const typename PairBlock<D>::Rows* rows = bl.rows.data();
+    const std::uint32_t* owner = bl.owner.data();
+    const std::uint32_t* partner = bl.partner.data();
+    const std::uint32_t* slot = bl.slot.data();
+    const std::uint16_t* material = in.material;
+    const std::uint32_t nm = static_cast<std::uint32_t>(in.nMaterials);
     const std::uint32_t* entry = bl.entry.data();
     Entry* out = bl.out.data();
     Vec<D>* history = in.history;
     for (std::uint32_t m = 0; m < nl; m += kLanes ? 4 : 1) {
         if constexpr (kLanes) {
-            const auto* it = items + m;
-            const LaneIndex ii = {std::int32_t(it[0].owner), std::int32_t(it[1].owner), std::int32_t(it[2].owner),
-                                  std::int32_t(it[3].owner)};
-            const LaneIndex jj = {std::int32_t(it[0].partner), std::int32_t(it[1].partner),
-                                  std::int32_t(it[2].partner), std::int32_t(it[3].partner)};
-            const LaneIndex cc = {std::int32_t(it[0].coeff), std::int32_t(it[1].coeff), std::int32_t(it[2].coeff),
-                                  std::int32_t(it[3].coeff)};
-            const auto* rw = rows + m;
-            Lanes t[4];
-            transpose4(rw[0].sep.c, rw[1].sep.c, rw[2].sep.c, rw[3].sep.c, t);
+            const LaneIndex ii = loadIndex(owner + m), jj = loadIndex(partner + m);
+            LaneIndex cc;
+            for (int l = 0; l < 4; ++l)
+                cc[l] = static_cast<std::int32_t>(material[owner[m + l]] * nm + material[partner[m + l]]);
             LaneVec<D> d;
-            for (int k = 0; k < D; ++k) d.c[k] = t[k];
-            LaneVec<D> xi = LaneVec<D>::zero();
-            if constexpr (Tangential::kHasHistory) {
-                transpose4(rw[0].spring.c, rw[1].spring.c, rw[2].spring.c, rw[3].spring.c, t);
-                for (int k = 0; k < D; ++k) xi.c[k] = t[k];
+            for (int k = 0; k < D; ++k) {
+                Lanes::Values v;
+                __builtin_memcpy(&v, bl.sep[k].data() + m, sizeof v);
+                d.c[k] = Lanes(v);
             }
+            LaneVec<D> xi = LaneVec<D>::zero();
+            if constexpr (Tangential::kHasHistory) xi = gather(history, loadIndex(slot + m));
             // Mostly the four pairs share one material pair: its coefficients broadcast, not gathered.
             const LanePairCoeffs c = (cc[1] == cc[0] && cc[2] == cc[0] && cc[3] == cc[0])
-                                         ? LanePairCoeffs(in.table[it[0].coeff])
+                                         ? LanePairCoeffs(in.table[cc[0]])
                                          : LanePairCoeffs(in.table, cc);
             LaneVec<D> f;
             LaneVec<A> nxft;
@@ -437,7 +596,7 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
                 for (int l = 0; l < 4; ++l) {
                     Vec<D> hv;
                     for (int k = 0; k < D; ++k) hv[k] = r[l].c[k];
-                    history[it[l].slot] = hv;
+                    history[slot[m + l]] = hv;
                 }
             }
             Entry* o[4];
@@ -448,19 +607,21 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
             transpose4(nb, o[0]->b.c, o[1]->b.c, o[2]->b.c, o[3]->b.c);
         } else {
             using V = KernelVec<D>;
-            const std::uint32_t i = items[m].owner, j = items[m].partner;
-            const V d = rowVec<D>(rows[m].sep.c);
+            const std::uint32_t i = owner[m], j = partner[m];
+            Vec<D> ds;
+            for (int k = 0; k < D; ++k) ds[k] = bl.sep[k][m];
+            const V d = kernelVec(ds);
             V xi = V::zero();
-            if constexpr (Tangential::kHasHistory) xi = rowVec<D>(rows[m].spring.c);
+            if constexpr (Tangential::kHasHistory) xi = kernelVec(history[slot[m]]);
             V f;
             KernelVec<A> nxft;
             double vir, overlap;
-            contactLaw<Normal, Tangential>(in.table[items[m].coeff], d, norm2(d), in.radius[i], in.radius[j],
+            contactLaw<Normal, Tangential>(in.table[material[i] * nm + material[j]], d, norm2(d), in.radius[i], in.radius[j],
                                            in.invMass[i], in.invMass[j], kernelVec(in.v[i]), kernelVec(in.v[j]),
                                            kernelVec(in.w[i]), kernelVec(in.w[j]), kernelVec(in.sv[i]),
                                            kernelVec(in.sv[j]), kernelVec(in.sw[i]), kernelVec(in.sw[j]), xi,
                                            in.clip, in.dt, f, nxft, vir, overlap);
-            if constexpr (Tangential::kHasHistory) history[items[m].slot] = storedVec(xi);
+            if constexpr (Tangential::kHasHistory) history[slot[m]] = storedVec(xi);
             Entry& o = out[kCross ? entry[m] : m];
             storeRow<D>(o.a.c, f);
             o.a.c[3] = vir;
@@ -476,7 +637,7 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
 /// apart, else into *virialSum (in particle order either way).
 ///
 /// The particles go in blocks of a few dozen, each in three passes: (1) the contact tests, without a branch on
-/// their outcome (findTouching); (2) the contact law on the touching pairs, four at a time in lanes (evalTouching),
+/// their outcome (findTouchingLanes, four at a time; findTouching); (2) the contact law on the touching pairs, four at a time in lanes (evalTouching),
 /// where their long chains of square roots and divisions overlap instead of waiting one behind the other; (3) in
 /// pair order, as when each pair was evaluated as its owner came, each contribution added to its owner and
 /// subtracted from its partner, and each particle finished. The law reads positions and velocities only, which no
@@ -519,15 +680,22 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
         b1 = b0 + 1;
         while (b1 < e && b1 - b0 < Block::kOwners && first[b1 + 1] - first[b0] <= Block::kPairs) ++b1;
         bl.fit(first[b1] - first[b0]);
-        const std::uint32_t nl = findTouching<D, Tangential, kCross>(in, first, b0, b1, e, cross, c, bl);
+        std::uint32_t nl;
+#ifdef __AVX2__
+        if constexpr (kLanes && !kCross) nl = findTouchingLanes<D, Tangential>(in, first, b0, b1, bl);
+        else
+#endif
+            nl = findTouching<D, Tangential, kCross>(in, first, b0, b1, e, cross, c, bl);
         if (nl > 0) {
             std::uint32_t padded = nl;
             if constexpr (kLanes) {
                 // The last lanes repeat the last pair: the same result, written twice to the same places.
                 for (; padded % 4 != 0; ++padded) {
                     const std::uint32_t s = nl - 1;
-                    bl.items[padded] = bl.items[s];
-                    bl.rows[padded] = bl.rows[s];
+                    bl.owner[padded] = bl.owner[s];
+                    bl.partner[padded] = bl.partner[s];
+                    bl.slot[padded] = bl.slot[s];
+                    for (int k = 0; k < D; ++k) bl.sep[k][padded] = bl.sep[k][s];
                     bl.entry[padded] = bl.entry[s];
                 }
             }
@@ -536,7 +704,7 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
         // (3) The sums, in pair order, and each particle finished.
         const typename Block::Entry* out = bl.out.data();
         const std::uint32_t* outPartner = bl.outPartner.data();
-        const typename Block::Item* items = bl.items.data();
+        const std::uint32_t* partner = bl.partner.data();
         // Every particle that the block's pairs add to starts here, once for the block.
         startUpTo(bl.reach);
         std::uint32_t t = 0;
@@ -552,7 +720,7 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
                 const KernelVec<kAngDim<D>> pn = rowVec<kAngDim<D>>(x.b.c);
                 fi += pf;
                 nxi += pn;
-                const std::uint32_t j = kCross ? outPartner[t] : items[t].partner;
+                const std::uint32_t j = kCross ? outPartner[t] : partner[t];
                 if (!kCross || j != Block::kNoPartner) {
                     f[j] = storedVec(kernelVec(f[j]) - pf);
                     nx[j] = storedVec(kernelVec(nx[j]) + pn);
