@@ -113,7 +113,7 @@ struct PairBlock {
         slot.resize(need);
         for (auto& c : sep) c.resize(need);
         entry.resize(need);
-        slotOwner.resize(need);
+        slotOwner.resize(need + 8);
         groupMask.resize(need / 4 + 2);
         groupBefore.resize(need / 4 + 2);
         outPartner.resize(need);
@@ -448,15 +448,19 @@ template <int D>
 /// Pass (1) over the block's particles [b0, b1) (one thread: no cross pairs), four listed pairs at a time in AVX
 /// lanes, taken in slot order across owners: the four contact tests give a mask; the touching pairs' fields are
 /// compacted by it (a table of lane permutations) and stored at the end of the list, which grows by the mask's
-/// population; the springs of the pairs not touching are cleared by the mask. A group with a periodic shift, and
-/// the last listed pairs (fewer than four), go one pair at a time (testPair). Same list as findTouching.
+/// population; the springs of the pairs not touching are cleared by the mask. The last listed pairs (fewer than
+/// four) go one pair at a time (testPair). Same list as findTouching.
 template <int D, class Tangential>
 [[gnu::noinline]] std::uint32_t findTouchingLanes(const PairInputs<D>& in, const std::uint32_t* first,
                                                   std::size_t b0, std::size_t b1, PairBlock<D>& bl) {
     const std::uint32_t k0 = first[b0], n = first[b1] - k0;
     std::uint32_t* own = bl.slotOwner.data();
-    for (std::size_t i = b0; i < b1; ++i)
-        for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) own[k - k0] = static_cast<std::uint32_t>(i);
+    // Eight at a time past each owner's end: the owners that follow overwrite what is not its own.
+    for (std::size_t i = b0; i < b1; ++i) {
+        const __m256i v = _mm256_set1_epi32(static_cast<int>(i));
+        for (std::uint32_t u = first[i] - k0; u < first[i + 1] - k0; u += 8)
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(own + u), v);
+    }
     const std::uint32_t* partner = in.partner;
     std::uint8_t* gmask = bl.groupMask.data();
     std::uint32_t* before = bl.groupBefore.data();
@@ -478,23 +482,27 @@ template <int D, class Tangential>
     for (; 4 * g + 4 <= n; ++g) {
         const std::uint32_t k = k0 + 4 * g;
         before[g] = nl;
-        std::uint32_t sh;
-        __builtin_memcpy(&sh, in.shift + k, 4);
-        if (sh != kNoShift4) {
-            unsigned m = 0;
-            for (unsigned l = 0; l < 4; ++l) onePair(k + l, l, m);
-            gmask[g] = static_cast<std::uint8_t>(m);
-            continue;
-        }
         const std::uint32_t* ii = own + 4 * g;
         const std::uint32_t* jj = partner + k;
+        const __m128i vi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ii));
+        const __m128i vj = _mm_loadu_si128(reinterpret_cast<const __m128i*>(jj));
         __m256d xi[D], xj[D];
         loadTransposed<D>(in.x, ii, xi);
         loadTransposed<D>(in.x, jj, xj);
-        const __m256d ri = _mm256_setr_pd(in.radius[ii[0]], in.radius[ii[1]], in.radius[ii[2]], in.radius[ii[3]]);
-        const __m256d rj = _mm256_setr_pd(in.radius[jj[0]], in.radius[jj[1]], in.radius[jj[2]], in.radius[jj[3]]);
+        const __m256d ri = gather(in.radius, reinterpret_cast<LaneIndex>(vi)).v;
+        const __m256d rj = gather(in.radius, reinterpret_cast<LaneIndex>(vj)).v;
         __m256d d[D];
         for (int c = 0; c < D; ++c) d[c] = _mm256_sub_pd(xi[c], xj[c]);
+        std::uint32_t sh;
+        __builtin_memcpy(&sh, in.shift + k, 4);
+        if (sh != kNoShift4) {
+            // Pairs across a periodic boundary: their shift added (as testPair does), the others' d kept.
+            const __m128i code = _mm_cvtepu8_epi32(_mm_cvtsi32_si128(static_cast<int>(sh)));
+            const LaneVec<D> sv = gather(in.shiftVec, reinterpret_cast<LaneIndex>(code));
+            const __m256d none =
+                _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_cmpeq_epi32(code, _mm_set1_epi32(PairList<D>::kNoShift))));
+            for (int c = 0; c < D; ++c) d[c] = _mm256_blendv_pd(_mm256_add_pd(d[c], sv.c[c].v), d[c], none);
+        }
         __m256d dist2 = _mm256_mul_pd(d[0], d[0]);  // as norm2: ((d0 d0 + d1 d1) + d2 d2)
         for (int c = 1; c < D; ++c) dist2 = _mm256_add_pd(dist2, _mm256_mul_pd(d[c], d[c]));
         const __m256d rsum = _mm256_add_pd(ri, rj);
@@ -505,8 +513,6 @@ template <int D, class Tangential>
         const __m128i p32 = _mm_load_si128(reinterpret_cast<const __m128i*>(kCompact.i32[m]));
         for (int c = 0; c < D; ++c)
             _mm256_storeu_pd(sep[c] + nl, _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(d[c]), p64)));
-        const __m128i vi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ii));
-        const __m128i vj = _mm_loadu_si128(reinterpret_cast<const __m128i*>(jj));
         _mm_storeu_si128(reinterpret_cast<__m128i*>(outOwner + nl),
                          _mm_castps_si128(_mm_permutevar_ps(_mm_castsi128_ps(vi), p32)));
         _mm_storeu_si128(reinterpret_cast<__m128i*>(outPartner + nl),
