@@ -69,14 +69,30 @@ std::optional<long long> parseInteger(std::string_view s) {
     return v;
 }
 
-std::vector<std::string> readLines(const std::filesystem::path& file, const std::string& key) {
-    std::ifstream in(file);
-    if (!in) throw ScenarioError({file.string(), 0}, key, "cannot open the particle file");
-    std::vector<std::string> lines;
-    for (std::string line; std::getline(in, line);) {
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        lines.push_back(std::move(line));
+/// The lines of a particle file one at a time, each without a trailing '\r' (files written on Windows).
+class LineReader {
+public:
+    LineReader(const std::filesystem::path& file, const std::string& key) : in_(file) {
+        if (!in_) throw ScenarioError({file.string(), 0}, key, "cannot open the particle file");
     }
+    /// The next line into `line`; false at the end of the file. lineNumber() is then its number, from 1.
+    bool next(std::string& line) {
+        if (!std::getline(in_, line)) return false;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        ++number_;
+        return true;
+    }
+    int lineNumber() const { return number_; }
+
+private:
+    std::ifstream in_;
+    int number_ = 0;
+};
+
+std::vector<std::string> readLines(const std::filesystem::path& file, const std::string& key) {
+    LineReader reader(file, key);
+    std::vector<std::string> lines;
+    for (std::string line; reader.next(line);) lines.push_back(std::move(line));
     return lines;
 }
 
@@ -585,8 +601,7 @@ std::vector<FilePolygon> readPolygonCsv(const std::filesystem::path& file, const
 ParticleFile readLammpsData(const std::filesystem::path& file, const std::string& key) {
     const std::string name = file.string();
     // Read line by line, not held whole: a 32 000-atom file is 7 MB of lines, which would set the run's peak.
-    std::ifstream in(file);
-    if (!in) throw ScenarioError({name, 0}, key, "cannot open the particle file");
+    LineReader reader(file, key);
     ParticleFile out;
     // LAMMPS's default box when the header gives none.
     Vec3d lo{-0.5, -0.5, -0.5}, hi{0.5, 0.5, 0.5};
@@ -598,9 +613,9 @@ ParticleFile readLammpsData(const std::filesystem::path& file, const std::string
 
     // The first line is a title and is skipped, as LAMMPS does.
     std::string line;
-    std::getline(in, line);
-    for (int lineNo = 2; std::getline(in, line); ++lineNo) {
-        if (!line.empty() && line.back() == '\r') line.pop_back();
+    reader.next(line);
+    while (reader.next(line)) {
+        const int lineNo = reader.lineNumber();
         auto fail = [&](const std::string& what) { throw ScenarioError({name, lineNo}, key, what); };
         const std::string_view raw = line;
         const auto hash = raw.find('#');
