@@ -1,9 +1,12 @@
 // Convergence order of the integrators on a damped harmonic oscillator (PHYSICS.md F.1): x'' = -w0^2 x - 2 eta x'.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
+#include "core/rng.hpp"
 #include "tdm/integrators.hpp"
 
 namespace haet {
@@ -67,6 +70,82 @@ TEST(Integrators, VerletConvergesAtSecondOrder) {
     const double order = std::log2(e1 / e2);
     EXPECT_NEAR(order, 2.0, 0.2) << e1 << " " << e2;
 }
+
+// Velocity Verlet's corrector and next predictor four particles at a time (CorrectPredict::finishBlock, run by the
+// force pass on each block) against its twins, Corrector then Predictor one particle at a time: the same bits,
+// for blocks of every length 0..9 at every offset modulo 4, with frozen particles among them (which keep their
+// position and velocity and get the velocity as mean velocity), two steps in a row (the second reads the
+// accelerations the first stored).
+template <class T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+template <int D>
+void checkBlockStepMatchesTwins() {
+    Rng rng(7, 3);
+    auto u = [&] { return 2 * rng.uniform() - 1; };
+    auto vec = [&]<int N>(Vec<N>) {
+        Vec<N> r;
+        for (int k = 0; k < N; ++k) r[k] = u();
+        return r;
+    };
+    Particles<D> p;
+    const std::size_t n = 47;
+    for (std::size_t i = 0; i < n; ++i)
+        p.add(vec(Vec<D>{}), vec(Vec<D>{}), vec(Ang<D>{}), 0.5 + 0.2 * rng.uniform(), 1000, 0, i,
+              (i % 5 == 2 || i == 9 || i == 10) ? kFrozen : 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        p.f[i] = vec(Vec<D>{});
+        p.torque[i] = vec(Ang<D>{});
+    }
+    const double dt = 1e-3;
+    std::vector<Vec<D>> ref(p.x);
+    for (std::size_t i = 0; i < n; ++i) ref[i] += Vec<D>::filled(i % 3 == 0 ? 0.0 : 1e-3);
+    VelocityVerlet<D> one, blocks;
+    one.start(p, dt);
+    blocks.start(p, dt);
+    Particles<D> a = p, b = p;
+    StepMotion<D> ma, mb;
+    for (int step = 0; step < 2; ++step) {
+        // New forces, the same for both.
+        for (std::size_t i = 0; i < n; ++i) {
+            a.f[i] = b.f[i] = vec(Vec<D>{}) * 1e3;
+            a.torque[i] = b.torque[i] = vec(Ang<D>{});
+        }
+        const double limit2 = step == 0 ? 1e-300 : 1e-5;  // first step: every moving particle is "far"
+        bool farOne = false;
+        const auto c = one.corrector(a, dt);
+        const auto pr = one.predictor(a, dt, ma, ref.data(), limit2);
+        for (std::size_t i = 0; i < n; ++i) {
+            c(i, a.f[i], a.torque[i]);
+            farOne |= pr(i);
+        }
+        std::atomic<bool> farBlocks{false};
+        const auto cp = blocks.correctPredict(b, dt, mb, ref.data(), limit2, &farBlocks);
+        // Blocks of lengths 0, 1, ..., 9, cycling, so that they start at every offset modulo 4.
+        for (std::size_t s = 0, len = 0; s < n; s += len, len = (len + 1) % 10) cp.finishBlock(s, std::min(n, s + len));
+        EXPECT_TRUE(sameBits(a.x, b.x)) << "step " << step;
+        EXPECT_TRUE(sameBits(a.v, b.v)) << "step " << step;
+        EXPECT_TRUE(sameBits(a.w, b.w)) << "step " << step;
+        EXPECT_TRUE(sameBits(a.angle, b.angle)) << "step " << step;
+        EXPECT_TRUE(sameBits(ma.v, mb.v)) << "step " << step;
+        EXPECT_TRUE(sameBits(ma.w, mb.w)) << "step " << step;
+        EXPECT_EQ(farOne, farBlocks.load()) << "step " << step;
+    }
+    // Frozen particles did not move; the others did.
+    for (std::size_t i = 0; i < n; ++i) {
+        if (p.frozen(i)) {
+            EXPECT_TRUE(std::memcmp(&b.x[i], &p.x[i], sizeof(Vec<D>)) == 0) << i;
+            EXPECT_TRUE(std::memcmp(&b.v[i], &p.v[i], sizeof(Vec<D>)) == 0) << i;
+        } else {
+            EXPECT_NE(b.x[i][0], p.x[i][0]) << i;
+        }
+    }
+}
+
+TEST(Integrators, VerletBlockStepMatchesOneParticleAtATime2D) { checkBlockStepMatchesTwins<2>(); }
+TEST(Integrators, VerletBlockStepMatchesOneParticleAtATime3D) { checkBlockStepMatchesTwins<3>(); }
 
 }  // namespace
 }  // namespace haet

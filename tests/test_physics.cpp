@@ -528,17 +528,26 @@ private:
     std::uint64_t h_ = 14695981039346656037ull;
 };
 
+/// 2000 steps; with chunk = 0 by step(), counting contacts into *contactSteps; otherwise by advanceTo over
+/// chunk steps at a time (where each step but the last of a call predicts the next in its force pass).
 template <int D>
-std::uint64_t runHashed(const Scenario& sc, int threads, std::uint64_t* contactSteps) {
+std::uint64_t runHashed(const Scenario& sc, int threads, std::uint64_t* contactSteps, int chunk = 0) {
     omp_set_num_threads(threads);
     EXPECT_EQ(omp_get_max_threads(), threads);
     World<D> w = buildWorld<D>(sc);
     EXPECT_GT(w.particles.size(), kParallelMin) << "below kParallelMin the loops run serially";
     TdmEngine<D> eng(w, tdmSettings<D>(sc, w));
     *contactSteps = 0;
-    for (int k = 0; k < 2000; ++k) {
-        eng.step();
-        *contactSteps += eng.forceStats().contacts;
+    if (chunk == 0) {
+        for (int k = 0; k < 2000; ++k) {
+            eng.step();
+            *contactSteps += eng.forceStats().contacts;
+        }
+    } else {
+        const double dt = eng.settings().dt;
+        while (eng.steps() < 2000)
+            eng.advanceTo(w.time + double(std::min<std::uint64_t>(chunk, 2000 - eng.steps())) * dt);
+        EXPECT_EQ(eng.steps(), 2000u);
     }
     StateHash h;
     const Particles<D>& p = w.particles;
@@ -569,6 +578,23 @@ TEST_P(ThreadCount, BitIdenticalWithOneAndTwoThreads) {
     EXPECT_GT(c1, 10000u) << "few contacts: the test would prove little";
     EXPECT_EQ(c1, c2);
     EXPECT_EQ(h1, h2) << "state after 2000 steps differs between 1 and 2 threads";
+}
+
+// advanceTo runs velocity Verlet's corrector and the next step's predictor on each block of the force pass:
+// the state is the one of step() after step(), bit for bit, with one and two threads (both scenes with Verlet).
+TEST_P(ThreadCount, StepsInOneCallMatchStepByStep) {
+    Scenario sc = dataScenario(GetParam());
+    sc.tdm.integrator = IntegratorKind::Verlet;
+    sc.tdm.integratorGiven = true;
+    const int before = omp_get_max_threads();
+    std::uint64_t c = 0;
+    auto run = [&](int threads, int chunk) {
+        return sc.dimension == 3 ? runHashed<3>(sc, threads, &c, chunk) : runHashed<2>(sc, threads, &c, chunk);
+    };
+    const std::uint64_t byStep = run(1, 0);
+    EXPECT_EQ(run(1, 733), byStep);
+    EXPECT_EQ(run(2, 733), byStep);
+    omp_set_num_threads(before);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, ThreadCount, ::testing::Values("threads3d.toml", "threads2d.toml"),

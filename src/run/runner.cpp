@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <fmt/format.h>
@@ -500,8 +501,10 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     Progress progress(tty, sc.duration);
     double nextSeries = 0, nextSnap = 0;
     const double eps = eng->timeTolerance();
-    // Progress updates at least every 1/500 of the run (and never less than one step), so the line stays live.
-    const double chunk = std::max(sc.duration / 500, 2 * eps);
+    // On a terminal the progress line updates at least every 1/500 of the run (and never less than one step), so
+    // it stays live; otherwise the engine runs from output to output in one call (a time-driven engine predicts
+    // each step in the pass of the step before, except the last step of a call).
+    const double chunk = tty ? std::max(sc.duration / 500, 2 * eps) : std::numeric_limits<double>::infinity();
     RunStatus status = RunStatus::Completed;
     std::string statusText = "completed";
     try {

@@ -2,6 +2,7 @@
 // Time-driven DEM engine: soft disks (2D) and spheres (3D) with the shared contact laws.
 // One step: predict (and the skin test) -> (rebuild the pair list if any particle moved more than skin/2) ->
 // forces -> correct.
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -34,7 +35,9 @@ public:
 
     /// One time step. Throws SimulationError on NaN or excessive overlap.
     void step();
-    /// Steps until the time reaches t (to within half a step).
+    /// Steps until the time reaches t (to within half a step): the same state as step() repeated, bit for bit.
+    /// If a step fails its health check (SimulationError) inside this call, the particles may already hold the
+    /// prediction for the step after it.
     void advanceTo(double t);
 
     const TdmSettings& settings() const { return s_; }
@@ -60,8 +63,13 @@ public:
     double pairVirial() const;
 
 private:
-    /// Forces at the current (predicted) state; with correct, also the integrator's corrector.
-    void computeForces(bool correct);
+    /// Forces at the current (predicted) state; with correct, also the integrator's corrector; with nextMoved
+    /// (velocity Verlet only), also the predictor of the next step, which sets *nextMoved as predict() returns.
+    void computeForces(bool correct, std::atomic<bool>* nextMoved = nullptr);
+    /// The rest of a step whose prediction is done (moved: what it returned): time, rebuild, forces, health.
+    void finishStep(bool moved, std::atomic<bool>* nextMoved);
+    /// The drift beyond which the pair list is rebuilt, squared: (skin / 2)^2.
+    double driftLimit2() const { return 0.25 * s_.skin * s_.skin; }
     void rebuild(bool sort);
     void checkHealth() const;
 

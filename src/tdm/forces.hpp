@@ -746,6 +746,8 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
             }
             if (!pt.finite && st.nonFinite == ForceStats::kNone) st.nonFinite = i;
         }
+        // A step on the whole block, now that its particles are finished (VelocityVerlet::CorrectPredict).
+        if constexpr (requires { then.finishBlock(b0, b1); }) then.finishBlock(b0, b1);
     }
     return st;
 }

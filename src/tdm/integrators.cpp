@@ -1,5 +1,8 @@
 #include "tdm/integrators.hpp"
 
+#include <cstring>
+#include <utility>
+
 namespace haet {
 
 template <class T>
@@ -41,38 +44,93 @@ void VelocityVerlet<D>::start(const Particles<D>& p, double) {
 }
 
 template <int D>
-bool VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) {
+typename VelocityVerlet<D>::Predictor VelocityVerlet<D>::predictor(Particles<D>& p, double dt, StepMotion<D>& m,
+                                                                  const Vec<D>* ref, double limit2) {
     const std::size_t n = p.tdmCount();
-    const double h2 = 0.5 * dt * dt;
     m.v.resize(n);
     m.w.resize(n);
-    // Raw pointers: stores through them cannot alias the vectors' own data pointers, so the loop stays tight.
-    Vec<D>* __restrict x = p.x.data();
-    Vec<D>* __restrict v = p.v.data();
-    Ang<D>* __restrict ang = p.angle.data();
-    Ang<D>* __restrict w = p.w.data();
-    Vec<D>* __restrict mv = m.v.data();
-    Ang<D>* __restrict mw = m.w.data();
-    const Vec<D>* __restrict acc = acc_.data();
-    const Ang<D>* __restrict alpha = alpha_.data();
-    const std::uint8_t* __restrict flags = p.flags.data();
+    return {p.x.data(), p.v.data(),     p.angle.data(), p.w.data(),     m.v.data(), m.w.data(),
+            acc_.data(), alpha_.data(), p.flags.data(), ref,            dt,         limit2};
+}
+
+template <int D>
+bool VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) {
+    const std::size_t n = p.tdmCount();
+    const Predictor pr = predictor(p, dt, m, ref, limit2);
     bool moved = false;
 #pragma omp parallel for schedule(static) reduction(|| : moved) if (n >= kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) {
-        if (flags[i] & kFrozen) {
-            mv[i] = v[i];
-            mw[i] = w[i];
-            continue;
-        }
-        mv[i] = v[i] + acc[i] * (0.5 * dt);  // v(t + dt/2)
-        mw[i] = w[i] + alpha[i] * (0.5 * dt);
-        x[i] += v[i] * dt + acc[i] * h2;
-        v[i] += acc[i] * dt;
-        ang[i] += w[i] * dt + alpha[i] * h2;
-        w[i] += alpha[i] * dt;
-        moved |= norm2(x[i] - ref[i]) > limit2;
-    }
+    for (std::size_t i = 0; i < n; ++i) moved |= pr(i);
     return moved;
+}
+
+namespace {
+
+using V4 = double __attribute__((vector_size(32)));
+using V4i = std::int64_t __attribute__((vector_size(32)));
+
+inline V4 load4(const double* p) {
+    V4 r;
+    std::memcpy(&r, p, sizeof r);
+    return r;
+}
+inline void store4(double* p, V4 v) { std::memcpy(p, &v, sizeof v); }
+inline V4 splat(double s) { return V4{s, s, s, s}; }
+
+/// Four particles with W components each fill W registers; element k of register R belongs to particle (4R + k) / W.
+template <int W, int R>
+inline constexpr V4i kSpread = {(4 * R) / W, (4 * R + 1) / W, (4 * R + 2) / W, (4 * R + 3) / W};
+
+/// Velocity Verlet on four particles' W-component quantity (position, velocity, acceleration, mean velocity,
+/// force; or angle, spin, ...): Corrector then Predictor element by element; frozen particles (fz) keep
+/// everything and get mv = v.
+template <int W>
+[[gnu::always_inline]] inline void correctPredict4(const double* f, double* x, double* v, double* acc, double* mv,
+                                                    V4 scale, V4i fz, double dt, double h, double h2) {
+    [&]<int... R>(std::integer_sequence<int, R...>) {
+        (
+            [&] {
+                const V4 s = __builtin_shuffle(scale, kSpread<W, R>);
+                const V4i z = __builtin_shuffle(fz, kSpread<W, R>);
+                const V4 x0 = load4(x + 4 * R), v0 = load4(v + 4 * R), a0 = load4(acc + 4 * R);
+                const V4 a = load4(f + 4 * R) * s;
+                const V4 vi = v0 + (a - a0) * splat(h);  // the corrector: v(t + dt)
+                const V4 mvn = vi + a * splat(0.5 * dt);   // the predictor of the next step
+                const V4 xn = x0 + (vi * splat(dt) + a * splat(h2));
+                const V4 vn = vi + a * splat(dt);
+                store4(x + 4 * R, z ? x0 : xn);
+                store4(v + 4 * R, z ? v0 : vn);
+                store4(acc + 4 * R, z ? a0 : a);
+                store4(mv + 4 * R, z ? v0 : mvn);
+            }(),
+            ...);
+    }(std::make_integer_sequence<int, W>{});
+}
+
+}  // namespace
+
+template <int D>
+void VelocityVerlet<D>::CorrectPredict::finishBlock(std::size_t b, std::size_t e) const {
+    constexpr int A = kAngDim<D>;
+    const Predictor& pr = predict;
+    const double dt = pr.dt, h2 = 0.5 * dt * dt;
+    bool far = false;
+    std::size_t i = b;
+    for (; i + 4 <= e; i += 4) {
+        const std::uint8_t* fl = pr.flags + i;
+        const V4i fz = {-std::int64_t(fl[0] & kFrozen), -std::int64_t(fl[1] & kFrozen),
+                        -std::int64_t(fl[2] & kFrozen), -std::int64_t(fl[3] & kFrozen)};
+        correctPredict4<D>(f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(), correct.acc[i].c.data(),
+                           pr.mv[i].c.data(), load4(correct.invMass + i), fz, dt, correct.h, h2);
+        correctPredict4<A>(torque[i].c.data(), pr.ang[i].c.data(), pr.w[i].c.data(), correct.alpha[i].c.data(),
+                           pr.mw[i].c.data(), load4(correct.invInertia + i), fz, dt, correct.h, h2);
+        for (std::size_t k = i; k < i + 4; ++k)
+            far |= !(pr.flags[k] & kFrozen) && norm2(pr.x[k] - pr.ref[k]) > pr.limit2;
+    }
+    for (; i < e; ++i) {
+        correct(i, f[i], torque[i]);
+        far |= pr(i);
+    }
+    if (far) moved->store(true, std::memory_order_relaxed);
 }
 
 template <int D>
