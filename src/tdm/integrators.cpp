@@ -82,10 +82,11 @@ inline constexpr V4i kSpread = {(4 * R) / W, (4 * R + 1) / W, (4 * R + 2) / W, (
 
 /// Velocity Verlet on four particles' W-component quantity (position, velocity, acceleration, mean velocity,
 /// force; or angle, spin, ...): Corrector then Predictor element by element; frozen particles (fz) keep
-/// everything and get mv = v.
-template <int W>
+/// everything and get mv = v. With ref (positions), sq gets the squares of (new position - ref) element by element.
+template <int W, bool kDrift = false>
 [[gnu::always_inline]] inline void correctPredict4(const double* f, double* x, double* v, double* acc, double* mv,
-                                                    V4 scale, V4i fz, double dt, double h, double h2) {
+                                                    V4 scale, V4i fz, double dt, double h, double h2,
+                                                    const double* ref = nullptr, V4* sq = nullptr) {
     [&]<int... R>(std::integer_sequence<int, R...>) {
         (
             [&] {
@@ -95,15 +96,34 @@ template <int W>
                 const V4 a = load4(f + 4 * R) * s;
                 const V4 vi = v0 + (a - a0) * splat(h);  // the corrector: v(t + dt)
                 const V4 mvn = vi + a * splat(0.5 * dt);   // the predictor of the next step
-                const V4 xn = x0 + (vi * splat(dt) + a * splat(h2));
+                const V4 xn = z ? x0 : x0 + (vi * splat(dt) + a * splat(h2));
                 const V4 vn = vi + a * splat(dt);
-                store4(x + 4 * R, z ? x0 : xn);
+                store4(x + 4 * R, xn);
                 store4(v + 4 * R, z ? v0 : vn);
                 store4(acc + 4 * R, z ? a0 : a);
                 store4(mv + 4 * R, z ? v0 : mvn);
+                if constexpr (kDrift) {
+                    const V4 d = xn - load4(ref + 4 * R);
+                    sq[R] = d * d;
+                }
             }(),
             ...);
     }(std::make_integer_sequence<int, W>{});
+}
+
+/// The squared lengths of four particles' D-vectors from the squares of their components (in D registers, the
+/// particles' components one after the other), summed left to right as norm2().
+template <int D>
+[[gnu::always_inline]] inline V4 norms4(const V4* sq) {
+    if constexpr (D == 2) {
+        return __builtin_shuffle(sq[0], sq[1], V4i{0, 2, 4, 6}) + __builtin_shuffle(sq[0], sq[1], V4i{1, 3, 5, 7});
+    } else {
+        static_assert(D == 3);
+        const V4 x = __builtin_shuffle(__builtin_shuffle(sq[0], sq[1], V4i{0, 3, 6, 6}), sq[2], V4i{0, 1, 2, 5});
+        const V4 y = __builtin_shuffle(__builtin_shuffle(sq[0], sq[1], V4i{1, 4, 7, 7}), sq[2], V4i{0, 1, 2, 6});
+        const V4 z = __builtin_shuffle(__builtin_shuffle(sq[0], sq[1], V4i{2, 5, 5, 5}), sq[2], V4i{0, 1, 4, 7});
+        return (x + y) + z;
+    }
 }
 
 }  // namespace
@@ -119,12 +139,14 @@ void VelocityVerlet<D>::CorrectPredict::finishBlock(std::size_t b, std::size_t e
         const std::uint8_t* fl = pr.flags + i;
         const V4i fz = {-std::int64_t(fl[0] & kFrozen), -std::int64_t(fl[1] & kFrozen),
                         -std::int64_t(fl[2] & kFrozen), -std::int64_t(fl[3] & kFrozen)};
-        correctPredict4<D>(f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(), correct.acc[i].c.data(),
-                           pr.mv[i].c.data(), load4(correct.invMass + i), fz, dt, correct.h, h2);
+        V4 sq[D];
+        correctPredict4<D, true>(f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(), correct.acc[i].c.data(),
+                                 pr.mv[i].c.data(), load4(correct.invMass + i), fz, dt, correct.h, h2,
+                                 pr.ref[i].c.data(), sq);
         correctPredict4<A>(torque[i].c.data(), pr.ang[i].c.data(), pr.w[i].c.data(), correct.alpha[i].c.data(),
                            pr.mw[i].c.data(), load4(correct.invInertia + i), fz, dt, correct.h, h2);
-        for (std::size_t k = i; k < i + 4; ++k)
-            far |= !(pr.flags[k] & kFrozen) && norm2(pr.x[k] - pr.ref[k]) > pr.limit2;
+        const V4i beyond = (norms4<D>(sq) > splat(pr.limit2)) & ~fz;
+        far |= (beyond[0] | beyond[1] | beyond[2] | beyond[3]) != 0;
     }
     for (; i < e; ++i) {
         correct(i, f[i], torque[i]);
