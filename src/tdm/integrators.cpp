@@ -83,7 +83,7 @@ inline constexpr V4i kSpread = {(4 * R) / W, (4 * R + 1) / W, (4 * R + 2) / W, (
 /// Velocity Verlet on four particles' W-component quantity (position, velocity, acceleration, mean velocity,
 /// force; or angle, spin, ...): Corrector then Predictor element by element; frozen particles (fz) keep
 /// everything and get mv = v. With ref (positions), sq gets the squares of (new position - ref) element by element.
-template <int W, bool kDrift = false>
+template <int W, bool kAnyFrozen, bool kDrift = false>
 [[gnu::always_inline]] inline void correctPredict4(const double* f, double* x, double* v, double* acc, double* mv,
                                                     V4 scale, V4i fz, double dt, double h, double h2,
                                                     const double* ref = nullptr, V4* sq = nullptr) {
@@ -91,17 +91,24 @@ template <int W, bool kDrift = false>
         (
             [&] {
                 const V4 s = __builtin_shuffle(scale, kSpread<W, R>);
-                const V4i z = __builtin_shuffle(fz, kSpread<W, R>);
                 const V4 x0 = load4(x + 4 * R), v0 = load4(v + 4 * R), a0 = load4(acc + 4 * R);
                 const V4 a = load4(f + 4 * R) * s;
                 const V4 vi = v0 + (a - a0) * splat(h);  // the corrector: v(t + dt)
-                const V4 mvn = vi + a * splat(0.5 * dt);   // the predictor of the next step
-                const V4 xn = z ? x0 : x0 + (vi * splat(dt) + a * splat(h2));
-                const V4 vn = vi + a * splat(dt);
+                V4 mvn = vi + a * splat(0.5 * dt);         // the predictor of the next step
+                V4 xn = x0 + (vi * splat(dt) + a * splat(h2));
+                V4 vn = vi + a * splat(dt);
+                V4 an = a;
+                if constexpr (kAnyFrozen) {
+                    const V4i z = __builtin_shuffle(fz, kSpread<W, R>);
+                    xn = z ? x0 : xn;
+                    vn = z ? v0 : vn;
+                    an = z ? a0 : an;
+                    mvn = z ? v0 : mvn;
+                }
                 store4(x + 4 * R, xn);
-                store4(v + 4 * R, z ? v0 : vn);
-                store4(acc + 4 * R, z ? a0 : a);
-                store4(mv + 4 * R, z ? v0 : mvn);
+                store4(v + 4 * R, vn);
+                store4(acc + 4 * R, an);
+                store4(mv + 4 * R, mvn);
                 if constexpr (kDrift) {
                     const V4 d = xn - load4(ref + 4 * R);
                     sq[R] = d * d;
@@ -135,18 +142,28 @@ void VelocityVerlet<D>::CorrectPredict::finishBlock(std::size_t b, std::size_t e
     const double dt = pr.dt, h2 = 0.5 * dt * dt;
     bool far = false;
     std::size_t i = b;
-    for (; i + 4 <= e; i += 4) {
-        const std::uint8_t* fl = pr.flags + i;
-        const V4i fz = {-std::int64_t(fl[0] & kFrozen), -std::int64_t(fl[1] & kFrozen),
-                        -std::int64_t(fl[2] & kFrozen), -std::int64_t(fl[3] & kFrozen)};
+    // Four particles, with (kAnyFrozen) or without the frozen ones blended back.
+    auto four = [&]<bool kAnyFrozen>(V4i fz) {
         V4 sq[D];
-        correctPredict4<D, true>(f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(), correct.acc[i].c.data(),
-                                 pr.mv[i].c.data(), load4(correct.invMass + i), fz, dt, correct.h, h2,
-                                 pr.ref[i].c.data(), sq);
-        correctPredict4<A>(torque[i].c.data(), pr.ang[i].c.data(), pr.w[i].c.data(), correct.alpha[i].c.data(),
-                           pr.mw[i].c.data(), load4(correct.invInertia + i), fz, dt, correct.h, h2);
+        correctPredict4<D, kAnyFrozen, true>(f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(),
+                                             correct.acc[i].c.data(), pr.mv[i].c.data(), load4(correct.invMass + i),
+                                             fz, dt, correct.h, h2, pr.ref[i].c.data(), sq);
+        correctPredict4<A, kAnyFrozen>(torque[i].c.data(), pr.ang[i].c.data(), pr.w[i].c.data(),
+                                       correct.alpha[i].c.data(), pr.mw[i].c.data(), load4(correct.invInertia + i),
+                                       fz, dt, correct.h, h2);
         const V4i beyond = (norms4<D>(sq) > splat(pr.limit2)) & ~fz;
         far |= (beyond[0] | beyond[1] | beyond[2] | beyond[3]) != 0;
+    };
+    for (; i + 4 <= e; i += 4) {
+        const std::uint8_t* fl = pr.flags + i;
+        std::uint32_t fl4;
+        std::memcpy(&fl4, fl, sizeof fl4);
+        if ((fl4 & 0x01010101u * kFrozen) == 0) {
+            four.template operator()<false>(V4i{0, 0, 0, 0});
+        } else {
+            four.template operator()<true>(V4i{-std::int64_t(fl[0] & kFrozen), -std::int64_t(fl[1] & kFrozen),
+                                               -std::int64_t(fl[2] & kFrozen), -std::int64_t(fl[3] & kFrozen)});
+        }
     }
     for (; i < e; ++i) {
         correct(i, f[i], torque[i]);
