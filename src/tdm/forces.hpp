@@ -245,18 +245,32 @@ struct ParticleTally {
     bool finite;        ///< position and force finite
 };
 
+/// Whether every component of v is finite (inf - inf and NaN - NaN are NaN, anything else minus itself is 0).
+template <int N>
+[[gnu::always_inline]] inline bool allFinite(const Vec<N>& v) {
+    double s = 0;
+    for (int k = 0; k < N; ++k) s += v[k] - v[k];
+    return s == 0;
+}
+inline bool allFinite(const Wide3& v) {
+    const Wide3::Lanes z = v.l - v.l;
+    return (z[0] == 0) & (z[1] == 0) & (z[2] == 0);
+}
+
 /// Particle i's pair sums are complete (f: force, nx: sum of n x F_t): adds its wall contacts (in wall order),
 /// stores force and torque -a (sum) + wall torques, then runs the caller's per-particle step then(i, f, torque).
 template <int D, class Normal, class Tangential, class Then>
 [[gnu::always_inline]] inline ParticleTally finishParticle(Particles<D>& p, const PairInputs<D>& in,
                                                           const Wall<D>* walls, std::size_t nw,
                                                           Vec<D>* wallHistory, const ContactSetup& cs,
-                                                          double time, std::size_t i, const Owner<D>& a, Vec<D> f,
-                                                          const Ang<D>& nx, double worst, std::uint32_t contacts,
-                                                          Then& then) {
+                                                          double time, std::size_t i, const Owner<D>& a,
+                                                          KernelVec<D> fk, const KernelVec<kAngDim<D>>& nx,
+                                                          double worst, std::uint32_t contacts, Then& then) {
     const double ri = a.radius;
-    Ang<D> tq = nx * (-ri);
+    KernelVec<kAngDim<D>> tqk = nx * (-ri);
     if (nw > 0 && !(p.flags[i] & kFrozen)) {
+        Vec<D> f = storedVec(fk);
+        Ang<D> tq = storedVec(tqk);
         for (std::size_t w = 0; w < nw; ++w) {
             const Wall<D>& wall = walls[w];
             Vec<D>& hist = wallHistory[i * nw + w];
@@ -283,14 +297,15 @@ template <int D, class Normal, class Tangential, class Then>
             worst = std::max(worst, delta / ri);
             ++contacts;
         }
+        fk = kernelVec(f);
+        tqk = kernelVec(tq);
     }
-    p.f[i] = f;
-    p.torque[i] = tq;
-    const Vec<D> x = storedVec(a.x);
-    double s = 0;  // a NaN anywhere reaches the force of its particle in the same step
-    for (int k = 0; k < D; ++k) s += f[k] + x[k];
-    then(i, f, tq);
-    return {worst, contacts, std::isfinite(s)};
+    p.f[i] = storedVec(fk);
+    p.torque[i] = storedVec(tqk);
+    // A NaN anywhere reaches the force of its particle in the same step.
+    const bool finite = allFinite(fk + a.x);
+    then(i, p.f[i], p.torque[i]);
+    return {worst, contacts, finite};
 }
 
 /// Whether the contact law runs on four touching pairs at once (core/lanes.hpp): with AVX2, whose gathers load
@@ -681,6 +696,7 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
         }
     };
     RangeTally st;
+    double virialAcc = kCross ? 0.0 : *virialSum;  // the one-thread sum, in particle order
     std::size_t c = c0;
     for (std::size_t b0 = b, b1; b0 < e; b0 = b1) {
         b1 = b0 + 1;
@@ -735,11 +751,11 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
                 worst = std::max(worst, x.b.c[3]);
                 ++nc;
             }
-            const ParticleTally pt = finishParticle<D, Normal, Tangential>(
-                p, in, walls, nw, wh, cs, time, i, a, storedVec(fi), storedVec(nxi), worst, nc, then);
+            const ParticleTally pt = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, a, fi,
+                                                                           nxi, worst, nc, then);
             st.contacts += pt.contacts;
             if constexpr (kCross) virial[i] = vir;
-            else *virialSum += vir;
+            else virialAcc += vir;
             if (pt.worst > st.maxOverlapRatio) {
                 st.maxOverlapRatio = pt.worst;
                 st.worstParticle = i;
@@ -749,6 +765,7 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
         // A step on the whole block, now that its particles are finished (VelocityVerlet::CorrectPredict).
         if constexpr (requires { then.finishBlock(b0, b1); }) then.finishBlock(b0, b1);
     }
+    if constexpr (!kCross) *virialSum = virialAcc;
     return st;
 }
 
