@@ -267,7 +267,9 @@ template <int D, class Normal, class Tangential, class Then>
                                                           KernelVec<D> fk, const KernelVec<kAngDim<D>>& nx,
                                                           double worst, std::uint32_t contacts, Then& then) {
     const double ri = a.radius;
-    KernelVec<kAngDim<D>> tqk = nx * (-ri);
+    const KernelVec<kAngDim<D>> tqk = nx * (-ri);
+    // A NaN anywhere reaches the force of its particle in the same step.
+    bool finite;
     if (nw > 0 && !(p.flags[i] & kFrozen)) {
         Vec<D> f = storedVec(fk);
         Ang<D> tq = storedVec(tqk);
@@ -297,13 +299,14 @@ template <int D, class Normal, class Tangential, class Then>
             worst = std::max(worst, delta / ri);
             ++contacts;
         }
-        fk = kernelVec(f);
-        tqk = kernelVec(tq);
+        p.f[i] = f;
+        p.torque[i] = tq;
+        finite = allFinite(f + storedVec(a.x));
+    } else {
+        p.f[i] = storedVec(fk);
+        p.torque[i] = storedVec(tqk);
+        finite = allFinite(fk + a.x);
     }
-    p.f[i] = storedVec(fk);
-    p.torque[i] = storedVec(tqk);
-    // A NaN anywhere reaches the force of its particle in the same step.
-    const bool finite = allFinite(fk + a.x);
     then(i, p.f[i], p.torque[i]);
     return {worst, contacts, finite};
 }
@@ -702,65 +705,81 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
         b1 = b0 + 1;
         while (b1 < e && b1 - b0 < Block::kOwners && first[b1 + 1] - first[b0] <= Block::kPairs) ++b1;
         bl.fit(first[b1] - first[b0]);
-        std::uint32_t nl;
+        // The block's three steps; kCrossBlock: some of its pairs are cross pairs (their partner lies beyond e),
+        // taken from their slots in pair order, so the tests go one pair at a time.
+        auto runBlock = [&]<bool kCrossBlock>() __attribute__((always_inline)) {
+            std::uint32_t nl;
 #ifdef __AVX2__
-        if constexpr (kLanes && !kCross) nl = findTouchingLanes<D, Tangential>(in, first, b0, b1, bl);
-        else
+            if constexpr (kLanes && !kCrossBlock) nl = findTouchingLanes<D, Tangential>(in, first, b0, b1, bl);
+            else
 #endif
-            nl = findTouching<D, Tangential, kCross>(in, first, b0, b1, e, cross, c, bl);
-        if (nl > 0) {
-            std::uint32_t padded = nl;
-            if constexpr (kLanes) {
-                // The last lanes repeat the last pair: the same result, written twice to the same places.
-                for (; padded % 4 != 0; ++padded) {
-                    const std::uint32_t s = nl - 1;
-                    bl.owner[padded] = bl.owner[s];
-                    bl.partner[padded] = bl.partner[s];
-                    bl.slot[padded] = bl.slot[s];
-                    for (int k = 0; k < D; ++k) bl.sep[k][padded] = bl.sep[k][s];
-                    bl.entry[padded] = bl.entry[s];
+                nl = findTouching<D, Tangential, kCrossBlock>(in, first, b0, b1, e, cross, c, bl);
+            if (nl > 0) {
+                std::uint32_t padded = nl;
+                if constexpr (kLanes) {
+                    // The last lanes repeat the last pair: the same result, written twice to the same places.
+                    for (; padded % 4 != 0; ++padded) {
+                        const std::uint32_t s = nl - 1;
+                        bl.owner[padded] = bl.owner[s];
+                        bl.partner[padded] = bl.partner[s];
+                        bl.slot[padded] = bl.slot[s];
+                        for (int k = 0; k < D; ++k) bl.sep[k][padded] = bl.sep[k][s];
+                        bl.entry[padded] = bl.entry[s];
+                    }
                 }
+                evalTouching<D, Normal, Tangential, kCrossBlock, kLanes>(in, bl, padded);
             }
-            evalTouching<D, Normal, Tangential, kCross, kLanes>(in, bl, padded);
-        }
-        // (3) The sums, in pair order, and each particle finished.
-        const typename Block::Entry* out = bl.out.data();
-        const std::uint32_t* outPartner = bl.outPartner.data();
-        const std::uint32_t* partner = bl.partner.data();
-        // Every particle that the block's pairs add to starts here, once for the block.
-        startUpTo(bl.reach);
-        std::uint32_t t = 0;
-        for (std::size_t i = b0; i < b1; ++i) {
-            const Owner<D> a(in, i);
-            KernelVec<D> fi = kernelVec(f[i]);
-            KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
-            double worst = 0, vir = 0;
-            std::uint32_t nc = 0;
-            for (const std::uint32_t tEnd = bl.ownerEnd[i - b0]; t < tEnd; ++t) {
-                const typename Block::Entry& x = out[t];
-                const KernelVec<D> pf = rowVec<D>(x.a.c);
-                const KernelVec<kAngDim<D>> pn = rowVec<kAngDim<D>>(x.b.c);
-                fi += pf;
-                nxi += pn;
-                const std::uint32_t j = kCross ? outPartner[t] : partner[t];
-                if (!kCross || j != Block::kNoPartner) {
-                    f[j] = storedVec(kernelVec(f[j]) - pf);
-                    nx[j] = storedVec(kernelVec(nx[j]) + pn);
+            // (3) The sums, in pair order, and each particle finished.
+            const typename Block::Entry* out = bl.out.data();
+            const std::uint32_t* outPartner = bl.outPartner.data();
+            const std::uint32_t* partner = bl.partner.data();
+            // Every particle that the block's pairs add to starts here, once for the block.
+            startUpTo(bl.reach);
+            std::uint32_t t = 0;
+            for (std::size_t i = b0; i < b1; ++i) {
+                const Owner<D> a(in, i);
+                KernelVec<D> fi = kernelVec(f[i]);
+                KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
+                double worst = 0, vir = 0;
+                std::uint32_t nc = 0;
+                for (const std::uint32_t tEnd = bl.ownerEnd[i - b0]; t < tEnd; ++t) {
+                    const typename Block::Entry& x = out[t];
+                    const KernelVec<D> pf = rowVec<D>(x.a.c);
+                    const KernelVec<kAngDim<D>> pn = rowVec<kAngDim<D>>(x.b.c);
+                    fi += pf;
+                    nxi += pn;
+                    const std::uint32_t j = kCrossBlock ? outPartner[t] : partner[t];
+                    if (!kCrossBlock || j != Block::kNoPartner) {
+                        f[j] = storedVec(kernelVec(f[j]) - pf);
+                        nx[j] = storedVec(kernelVec(nx[j]) + pn);
+                    }
+                    vir += x.a.c[3];
+                    worst = std::max(worst, x.b.c[3]);
+                    ++nc;
                 }
-                vir += x.a.c[3];
-                worst = std::max(worst, x.b.c[3]);
-                ++nc;
+                const ParticleTally pt = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, a, fi,
+                                                                               nxi, worst, nc, then);
+                st.contacts += pt.contacts;
+                if constexpr (kCross) virial[i] = vir;
+                else virialAcc += vir;
+                if (pt.worst > st.maxOverlapRatio) {
+                    st.maxOverlapRatio = pt.worst;
+                    st.worstParticle = i;
+                }
+                if (!pt.finite && st.nonFinite == ForceStats::kNone) st.nonFinite = i;
             }
-            const ParticleTally pt = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, a, fi,
-                                                                           nxi, worst, nc, then);
-            st.contacts += pt.contacts;
-            if constexpr (kCross) virial[i] = vir;
-            else virialAcc += vir;
-            if (pt.worst > st.maxOverlapRatio) {
-                st.maxOverlapRatio = pt.worst;
-                st.worstParticle = i;
-            }
-            if (!pt.finite && st.nonFinite == ForceStats::kNone) st.nonFinite = i;
+        };
+        if constexpr (kCross) {
+            // Most blocks of a range have no cross pair (those lie along the face between two ranges): their
+            // pairs go the one-thread way.
+            const std::uint32_t* pb = in.partner + first[b0];
+            const std::uint32_t* pe = in.partner + first[b1];
+            if (pb != pe && *std::max_element(pb, pe) >= e)
+                runBlock.template operator()<true>();
+            else
+                runBlock.template operator()<false>();
+        } else {
+            runBlock.template operator()<false>();
         }
         // A step on the whole block, now that its particles are finished (VelocityVerlet::CorrectPredict).
         if constexpr (requires { then.finishBlock(b0, b1); }) then.finishBlock(b0, b1);
