@@ -2,6 +2,8 @@
 // periodic wrapping, moving walls, frozen particles, the TC model and the collapse guard.
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include <cmath>
 #include <string>
 #include <vector>
@@ -246,6 +248,32 @@ void elasticGasEnergy(bool rough, std::uint64_t minCollisions) {
 
 TEST(EdmEngine, ElasticSmoothGasConservesEnergy3D) { elasticGasEnergy<3>(false, 100000); }
 TEST(EdmEngine, ElasticRoughGasConservesEnergy2D) { elasticGasEnergy<2>(true, 100000); }
+
+// A smooth pair (Walton's rule with mu = 0, whatever beta0; or a constant beta0 = -1) gets no tangential impulse: the
+// spins stay exactly as they were (the engine neither reads nor writes them), translation conserves energy.
+template <int D>
+void smoothCollisionsKeepSpins(EdmSettings::Tangential rule, double beta0) {
+    GasSpec g;
+    g.n = D == 3 ? 300 : 400;
+    g.phi = D == 3 ? 0.2 : 0.25;
+    g.polydisperse = true;
+    g.spin = 3;
+    World<D> w = makeGas<D>(g, edmContact(1.0, 0.0, beta0));
+    const std::vector<Ang<D>> w0 = w.particles.w;
+    EdmSettings s;
+    s.tangential = rule;
+    EdmEngine<D> eng(w, s);
+    const double e0 = kineticEnergyEdm(w.particles);
+    for (double t = 1; eng.collisions() < 20000; t += 1) eng.advanceTo(t);
+    ASSERT_EQ(w.particles.w.size(), w0.size());
+    EXPECT_EQ(std::memcmp(w.particles.w.data(), w0.data(), w0.size() * sizeof(Ang<D>)), 0);
+    EXPECT_NEAR(kineticEnergyEdm(w.particles), e0, 1e-12 * e0);
+}
+
+TEST(EdmEngine, SmoothCollisionsKeepSpinsWalton3D) { smoothCollisionsKeepSpins<3>(EdmSettings::Tangential::Walton, 0.4); }
+TEST(EdmEngine, SmoothCollisionsKeepSpinsConstant2D) {
+    smoothCollisionsKeepSpins<2>(EdmSettings::Tangential::Constant, -1.0);
+}
 
 TEST(EdmEngine, MomentumConservedInPeriodicGas) {
     GasSpec g;

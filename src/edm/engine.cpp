@@ -1124,6 +1124,12 @@ CollisionLaw EdmEngine<D>::lawFor(int matA, int matB, bool elastic) const {
 }
 
 template <int D>
+bool EdmEngine<D>::smoothPair(int matA, int matB) const {
+    const PairCoeffs& c = w_.contact.pair(matA, matB);
+    return s_.tangential == EdmSettings::Tangential::Walton ? c.mu == 0 : c.beta0 == -1;
+}
+
+template <int D>
 bool EdmEngine<D>::tcElastic(std::uint32_t a, std::uint32_t b, double t) const {
     if (!(tc_ > 0)) return false;
     if (t - tLast_[a] < tc_) return true;
@@ -1165,8 +1171,18 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     // through infinitely many collisions.
     const double gAcc = fb ? dot(n, g_) : 0;
     const double uRest = (tc_ > 0 && gAcc < 0) ? -gAcc * tc_ : 0;
-    CollisionBody<D> b1{va, p.w[i], hot_[a].r, p.invMass[i], p.invInertia[i]};
-    CollisionBody<D> b2{vb, p.w[j], hot_[b].r, fb ? 0.0 : p.invMass[j], fb ? 0.0 : p.invInertia[j]};
+    const int ma = p.material[i], mb = p.material[j];
+    // A smooth pair (beta = -1 whatever the velocities) gets an impulse along n, which leaves the spins alone:
+    // its bodies go without rotation, so the spins are neither read nor written.
+    const bool smooth = smoothPair(ma, mb);
+    CollisionBody<D> b1{va, Ang<D>::zero(), hot_[a].r, p.invMass[i], 0.0};
+    CollisionBody<D> b2{vb, Ang<D>::zero(), hot_[b].r, fb ? 0.0 : p.invMass[j], 0.0};
+    if (!smooth) {
+        b1.w = p.w[i];
+        b1.invInertia = p.invInertia[i];
+        b2.w = p.w[j];
+        b2.invInertia = fb ? 0.0 : p.invInertia[j];
+    }
     const double gn = dot(contactVelocity(b1, b2, n), n);
     const bool approaching = bdot < 0 && gn < 0;
     if (!approaching && !(uRest > gn)) {  // not approaching (grazing, round-off): nothing happens
@@ -1177,8 +1193,7 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     advance(b, t);
     const bool elastic = tcElastic(a, fb ? kNil : b, t);
     bool hop = false;
-    const Vec<D> P =
-        impulseWithHop(b1, b2, n, lawFor(p.material[i], p.material[j], elastic), approaching, gn, uRest, hop);
+    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(ma, mb, elastic), approaching, gn, uRest, hop);
     const double before = kineticEnergy(b1) + kineticEnergy(b2);
     applyImpulse(b1, b2, n, P);
     stats_.dissipated += before - kineticEnergy(b1) - kineticEnergy(b2);
@@ -1187,12 +1202,12 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
         if (!fb) tcHandovers_.push_back(j);
     }
     hot_[a].v = b1.v;
-    p.w[i] = b1.w;
+    if (!smooth) p.w[i] = b1.w;
     ++link_[a].count;
     if (tc_ > 0) tLast_[a] = t;
     if (!fb) {
         hot_[b].v = b2.v;
-        p.w[j] = b2.w;
+        if (!smooth) p.w[j] = b2.w;
         ++link_[b].count;
         if (tc_ > 0) tLast_[b] = t;
     }
@@ -1212,7 +1227,9 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     const double gAcc = dot(n, g_);
     const double uRest = (tc_ > 0 && gAcc < 0) ? -gAcc * tc_ : 0;
     const Vec<D> vs = velAt(hot_[s], t);
-    CollisionBody<D> b1{vs, p.w[i], hot_[s].r, p.invMass[i], p.invInertia[i]};
+    const bool smooth = smoothPair(p.material[i], wl.material);  // as in collidePair
+    CollisionBody<D> b1{vs, smooth ? Ang<D>::zero() : p.w[i], hot_[s].r, p.invMass[i],
+                        smooth ? 0.0 : p.invInertia[i]};
     CollisionBody<D> b2{wl.velocity, Ang<D>::zero(), 0.0, 0.0, 0.0};
     const double gn = dot(vs - wl.velocity, n);
     if (gn >= 0 && !(uRest > gn)) {  // not approaching: nothing happens, no state change
@@ -1228,7 +1245,7 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     stats_.dissipated += before - kineticEnergy(b1);
     if (elastic && zoned_ && zone_.handoverOnTc) tcHandovers_.push_back(i);
     hot_[s].v = b1.v;
-    p.w[i] = b1.w;
+    if (!smooth) p.w[i] = b1.w;
     ++link_[s].count;
     if (tc_ > 0) tLast_[s] = t;
     ++stats_.wallCollisions;

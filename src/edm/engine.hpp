@@ -326,6 +326,9 @@ private:
     Vec<D> velAt(const Hot& h, double t) const;
     bool frozen(std::uint32_t s) const { return hot_[s].t == kNever; }  // also true for a free slot
     CollisionLaw lawFor(int matA, int matB, bool elastic) const;
+    /// Whether the collisions of a material pair have beta = -1 whatever the velocities (Walton's rule with
+    /// mu = 0, or a constant beta0 = -1): no tangential impulse, so rotation is left alone.
+    bool smoothPair(int matA, int matB) const;
     bool tcElastic(std::uint32_t a, std::uint32_t b, double t) const;  // b = kNil: wall or frozen partner
     void notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop, const Vec<D>& P);
 
