@@ -58,8 +58,19 @@ bool VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, co
     const std::size_t n = p.tdmCount();
     const Predictor pr = predictor(p, dt, m, ref, limit2);
     bool moved = false;
+    // The pointers as restrict locals: stores through them cannot change the pointers, so the loop stays tight.
+    Vec<D>* __restrict x = pr.x;
+    Vec<D>* __restrict v = pr.v;
+    Ang<D>* __restrict ang = pr.ang;
+    Ang<D>* __restrict w = pr.w;
+    Vec<D>* __restrict mv = pr.mv;
+    Ang<D>* __restrict mw = pr.mw;
+    const Vec<D>* __restrict acc = pr.acc;
+    const Ang<D>* __restrict alpha = pr.alpha;
+    const std::uint8_t* __restrict flags = pr.flags;
 #pragma omp parallel for schedule(static) reduction(|| : moved) if (n >= kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) moved |= pr(i);
+    for (std::size_t i = 0; i < n; ++i)
+        moved |= Predictor::one(i, x, v, ang, w, mv, mw, acc, alpha, flags, ref, dt, limit2);
     return moved;
 }
 

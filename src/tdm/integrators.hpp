@@ -63,13 +63,10 @@ public:
         double h;  ///< dt / 2 [s]
         [[gnu::always_inline]] void operator()(std::size_t i, const Vec<D>& f, const Ang<D>& torque) const {
             if (flags[i] & kFrozen) return;
-            // Values first, stores last: the stores cannot change what is read, whatever the pointers alias.
             const Vec<D> a = f * invMass[i];
             const Ang<D> al = torque * invInertia[i];
-            const Vec<D> vi = v[i] + (a - acc[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
-            const Ang<D> wi = w[i] + (al - alpha[i]) * h;
-            v[i] = vi;
-            w[i] = wi;
+            v[i] += (a - acc[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
+            w[i] += (al - alpha[i]) * h;
             acc[i] = a;
             alpha[i] = al;
         }
@@ -83,39 +80,39 @@ public:
     /// over the step into m; returns whether the particle is now farther than sqrt(limit2) from ref[i].
     /// predict() runs it over all particles.
     struct Predictor {
-        Vec<D>* __restrict x;
-        Vec<D>* __restrict v;
-        Ang<D>* __restrict ang;
-        Ang<D>* __restrict w;
-        Vec<D>* __restrict mv;
-        Ang<D>* __restrict mw;
-        const Vec<D>* __restrict acc;
-        const Ang<D>* __restrict alpha;
-        const std::uint8_t* __restrict flags;
-        const Vec<D>* __restrict ref;
+        Vec<D>* x;
+        Vec<D>* v;
+        Ang<D>* ang;
+        Ang<D>* w;
+        Vec<D>* mv;
+        Ang<D>* mw;
+        const Vec<D>* acc;
+        const Ang<D>* alpha;
+        const std::uint8_t* flags;
+        const Vec<D>* ref;
         double dt, limit2;
         [[gnu::always_inline]] bool operator()(std::size_t i) const {
-            const Vec<D> vi = v[i];
-            const Ang<D> wi = w[i];
+            return one(i, x, v, ang, w, mv, mw, acc, alpha, flags, ref, dt, limit2);
+        }
+        /// The predictor of particle i on the arrays given.
+        [[gnu::always_inline]] static bool one(std::size_t i, Vec<D>* __restrict x, Vec<D>* __restrict v,
+                                               Ang<D>* __restrict ang, Ang<D>* __restrict w, Vec<D>* __restrict mv,
+                                               Ang<D>* __restrict mw, const Vec<D>* __restrict acc,
+                                               const Ang<D>* __restrict alpha, const std::uint8_t* __restrict flags,
+                                               const Vec<D>* __restrict ref, double dt, double limit2) {
             if (flags[i] & kFrozen) {
-                mv[i] = vi;
-                mw[i] = wi;
+                mv[i] = v[i];
+                mw[i] = w[i];
                 return false;
             }
-            // Values first, stores last (as in Corrector).
             const double h2 = 0.5 * dt * dt;
-            const Vec<D> a = acc[i];
-            const Ang<D> al = alpha[i];
-            const Vec<D> xi = x[i] + (vi * dt + a * h2);
-            const Ang<D> angi = ang[i] + (wi * dt + al * h2);
-            const bool far = norm2(xi - ref[i]) > limit2;
-            mv[i] = vi + a * (0.5 * dt);  // v(t + dt/2)
-            mw[i] = wi + al * (0.5 * dt);
-            x[i] = xi;
-            v[i] = vi + a * dt;
-            ang[i] = angi;
-            w[i] = wi + al * dt;
-            return far;
+            mv[i] = v[i] + acc[i] * (0.5 * dt);  // v(t + dt/2)
+            mw[i] = w[i] + alpha[i] * (0.5 * dt);
+            x[i] += v[i] * dt + acc[i] * h2;
+            v[i] += acc[i] * dt;
+            ang[i] += w[i] * dt + alpha[i] * h2;
+            w[i] += alpha[i] * dt;
+            return norm2(x[i] - ref[i]) > limit2;
         }
     };
     /// Sizes m for the particles and returns the predictor over them.
