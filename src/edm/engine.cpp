@@ -660,7 +660,6 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
         return;
     }
     const Domain<D>& dom = w_.domain;
-    queue_.prefetchPath(s);
     const Hot& hs = hot_[s];
     const Shift ws = wrapsOf(link_[s].wrap);
     // Cell coordinates and the faces s can leave through. The exit is computed from the state at "now": from the
@@ -766,7 +765,6 @@ void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
         __builtin_prefetch(&hot_[heads[q]]);
         __builtin_prefetch(&link_[heads[q]]);
     }
-    queue_.prefetchRivals(s);
     // The candidates are collected four at a time and evaluated side by side (candidates4): the arithmetic of
     // candidateTime lane by lane. Candidates later than the best pair or wall event so far are skipped before the
     // square root, but never because they are later than the cell exit: rec_[s].coll must stay the earliest over

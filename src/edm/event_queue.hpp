@@ -54,17 +54,6 @@ public:
     double time(std::uint32_t i) const { return time_[i]; }
     std::size_t memoryBytes() const { return time_.capacity() * sizeof(double) + node_.capacity() * 4; }
 
-    /// Cache hints for an update of slot i that is coming (the engine's prediction of slot i ends with it): first
-    /// the nodes on its path to the root, then, once those are in, the times of the winners beside the path. An
-    /// update of the slot that just won replays the whole path, one dependent pair of loads per level.
-    void prefetchPath(std::uint32_t i) const {
-        for (std::size_t k = leafOf(i) >> 1; k >= 1; k >>= 1) __builtin_prefetch(&node_[2 * k < leaves_ ? 2 * k : k]);
-        __builtin_prefetch(&time_[i]);
-    }
-    void prefetchRivals(std::uint32_t i) const {
-        for (std::size_t c = leafOf(i); c > 1; c >>= 1) __builtin_prefetch(&time_[winner(c ^ 1)]);
-    }
-
 private:
     // The tree has as many leaves as slots (at least two), node k has the children 2k and 2k + 1, and the leaves are
     // the nodes leaves_ to 2 leaves_ - 1. Unless leaves_ is a power of two they lie on two levels, the deeper ones
