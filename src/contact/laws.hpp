@@ -2,6 +2,7 @@
 // Contact laws as pure functions of explicit inputs (PHYSICS.md B). One law serves particle-particle and
 // particle-wall contacts: a wall is a partner of infinite mass and radius (m_eff = m, R_eff = a).
 #include <cmath>
+#include <cstring>
 
 #include "core/lanes.hpp"
 #include "core/vec.hpp"
@@ -29,6 +30,19 @@ struct PairCoeffs {
     double restitution = 1;  ///< e that the soft law produces (incl. the contact-ending rule)
     double beta0 = 1;        ///< Walton's sticking tangential restitution
 };
+
+/// Whether the force law of every pair of the table is the same, bit for bit (the fields LanePairCoeffs reads):
+/// then the force loop takes the first entry for every contact instead of looking up the pair's materials.
+inline bool uniformForceLaw(const PairCoeffs* table, std::size_t n) {
+    constexpr double PairCoeffs::*kFields[] = {&PairCoeffs::knConst, &PairCoeffs::knPerMeff, &PairCoeffs::gnPerMeff,
+                                               &PairCoeffs::hertzK,  &PairCoeffs::dissipationTime,
+                                               &PairCoeffs::tsujiAlpha, &PairCoeffs::ktRatio, &PairCoeffs::ktConst,
+                                               &PairCoeffs::gtPerMeff, &PairCoeffs::mu};
+    for (std::size_t k = 1; k < n; ++k)
+        for (const auto f : kFields)
+            if (std::memcmp(&(table[k].*f), &(table[0].*f), sizeof(double)) != 0) return false;
+    return true;
+}
 
 /// The coefficients of four material pairs side by side, one per lane (the force loop's four contacts at once).
 struct LanePairCoeffs {

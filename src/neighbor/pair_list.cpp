@@ -264,7 +264,7 @@ void collectPairs(std::size_t n, const Candidates& candidates, PairList<D>& out)
     }
 }
 
-/// Carries history from old (same particle numbering) into out; the thread split is left to be built.
+/// Carries history from old (same particle numbering) into out; the thread split and owners are left to be made.
 template <int D>
 void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
     const std::size_t np = out.first[n];
@@ -281,7 +281,7 @@ void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
             }
         }
     }
-    out.split = ThreadSplit{};
+    out.dropDerived();
 }
 
 }  // namespace
@@ -376,7 +376,7 @@ void keepTouchingPairs(PairList<D>& list) {
     list.shift = std::vector<std::uint8_t>(list.shift.begin(), list.shift.begin() + o);
     list.history = list.history.empty() ? std::vector<Vec<D>>{}
                                         : std::vector<Vec<D>>(list.history.begin(), list.history.begin() + o);
-    list.split = ThreadSplit{};
+    list.dropDerived();
 }
 
 template <int D>
@@ -531,7 +531,7 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
         }
     }
     list.shiftVec = makeShiftVectors(dom);
-    list.split = ThreadSplit{};
+    list.dropDerived();
     if (appended) {
         // Every new pair has a new particle as its second: it comes after the kept partners of its row.
         std::sort(entries.begin(), entries.end(),
@@ -620,7 +620,7 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
         list.partner[k] = kept[k].j;
         list.history[k] = kept[k].h;
     }
-    list.split = ThreadSplit{};
+    list.dropDerived();
 }
 
 #define HAET_INSTANTIATE(D)                                                                                     \

@@ -5,6 +5,7 @@
 // Layout: a half list in CSR form. Pairs of particle i are [first[i], first[i+1]) with partners j > i, sorted
 // by j. Each pair carries an image-shift code so that r_i - r_j + shift is the minimum-image separation for as
 // long as no particle has moved more than skin/2 since the build.
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -34,8 +35,22 @@ struct PairList {
     std::vector<std::uint8_t> shift;    ///< image-shift code of each pair, index into shiftVec
     std::vector<Vec<D>> history;        ///< tangential spring of each pair [m]; zero when not touching
     std::vector<Vec<D>> shiftVec;       ///< 3^D shift vectors [m]
-    // The threaded disk force loop's split: buildThreadSplit() makes it, a build leaves it empty.
-    ThreadSplit split;
+    // Made from the list when first needed, dropped by every change of the list (dropDerived):
+    ThreadSplit split;                  ///< the threaded disk force loop's split (buildThreadSplit)
+    std::vector<std::uint32_t> owner;   ///< owner i of each pair (makeOwners), for the four-wide contact tests
+
+    /// Forgets what was made from the list (after the list changed).
+    void dropDerived() {
+        split = ThreadSplit{};
+        owner = {};
+    }
+    /// Fills owner from first, unless it already matches the list.
+    void makeOwners() {
+        if (owner.size() == partner.size()) return;
+        owner.resize(partner.size());
+        for (std::size_t i = 0; i + 1 < first.size(); ++i)
+            std::fill(owner.begin() + first[i], owner.begin() + first[i + 1], static_cast<std::uint32_t>(i));
+    }
 
     std::size_t size() const { return partner.size(); }
     static constexpr int kNoShift = (D == 2) ? 4 : 13;

@@ -325,15 +325,10 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
     ps.pairEnergy.resize(pl.size());  // both written for every pair and particle below
     ps.wallEnergy.resize(n);
     ps.gravity = dom.gravity;
-    const int nm = cs.nMaterials;
-    const PairCoeffs* table = cs.table.data();
     const int nt = n >= kParallelMin ? omp_get_max_threads() : 1;
 
     // One pair, whichever its kind: force on i and the torques on i and j.
-    const PairInputs<2> in{p.x.data(),        p.v.data(),      p.w.data(),         p.radius.data(),
-                           p.invMass.data(),  p.material.data(), sv,               sw,
-                           pl.partner.data(), pl.shift.data(), pl.shiftVec.data(), pl.history.data(),
-                           table,             nm,              !cs.attraction,     dt};
+    const PairInputs<2> in = pairInputs(p, pl, cs, sv, sw, dt);
     // Inlined into each pass (GCC leaves a lambda used in three places out of line: 3 % more instructions).
     auto pair = [&](std::size_t i, std::uint32_t k, PairResult& r, double& worst, double& vir)
                     __attribute__((always_inline)) {

@@ -77,6 +77,7 @@ struct PairBlock {
     static constexpr std::uint32_t kPairs = 128;   ///< listed pairs per block
     static constexpr std::uint32_t kOwners = 64;   ///< particles per block
     static constexpr std::uint32_t kNoPartner = 0xFFFFFFFFu;  ///< an entry taken from a cross pair's slot
+    static constexpr std::uint32_t kNoOwner = 0xFFFFFFFFu;    ///< past the last touching pair
     /// Four doubles (a vector, zero-padded): the rows of four pairs are transposed into lanes and back.
     struct alignas(32) Row {
         double c[4];
@@ -93,15 +94,12 @@ struct PairBlock {
     std::vector<std::uint32_t> owner, partner, slot;
     std::vector<double> sep[D];
     std::vector<std::uint32_t> entry;
-    // The four-at-a-time contact tests (findTouchingLanes): the owner of each listed pair of the block, and per
-    // group of four listed pairs the mask of those touching and the number of touching pairs before the group.
-    std::vector<std::uint32_t> slotOwner;
-    std::vector<std::uint8_t> groupMask;
-    std::vector<std::uint32_t> groupBefore;
     // The entries of the block's owners, in pair order: evaluated pairs and (threaded) cross pairs.
     std::vector<Entry> out;
     std::vector<std::uint32_t> outPartner;  ///< j of each entry, kNoPartner for a cross pair
-    std::vector<std::uint32_t> ownerEnd;    ///< the block's particle b0 + q has entries [ownerEnd[q-1], ownerEnd[q])
+    /// Blocks with cross pairs: the block's particle b0 + q has entries [ownerEnd[q-1], ownerEnd[q]). Other blocks
+    /// find a particle's touching pairs by their owner: owner[nl] = kNoOwner ends the list.
+    std::vector<std::uint32_t> ownerEnd;
     std::size_t reach = 0;                  ///< 1 + the largest partner of the block's pairs (cross pairs aside)
 
     /// Room for a block of `pairs` listed pairs.
@@ -113,9 +111,6 @@ struct PairBlock {
         slot.resize(need);
         for (auto& c : sep) c.resize(need);
         entry.resize(need);
-        slotOwner.resize(need + 8);
-        groupMask.resize(need / 4 + 2);
-        groupBefore.resize(need / 4 + 2);
         outPartner.resize(need);
         out.resize(need);
         ownerEnd.resize(kOwners + 1);
@@ -151,14 +146,27 @@ struct PairInputs {
     const Vec<D>* sv;  ///< mean velocities over the last step (StepMotion)
     const Ang<D>* sw;
     const std::uint32_t* partner;
+    const std::uint32_t* owner;  ///< owner of each pair (PairList::owner, made for the four-wide contact tests)
     const std::uint8_t* shift;
     const Vec<D>* shiftVec;
     Vec<D>* history;
     const PairCoeffs* table;
     int nMaterials;
+    bool uniform;  ///< every material pair has the same force law (uniformForceLaw): table[0] serves all
     bool clip;
     double dt;
 };
+
+/// The views of one force evaluation (sv, sw: the step's mean velocities; dt: the step).
+template <int D>
+PairInputs<D> pairInputs(const Particles<D>& p, PairList<D>& pl, const ContactSetup& cs, const Vec<D>* sv,
+                         const Ang<D>* sw, double dt) {
+    return {p.x.data(),        p.v.data(),      p.w.data(),         p.radius.data(),
+            p.invMass.data(),  p.material.data(), sv,               sw,
+            pl.partner.data(), pl.owner.data(), pl.shift.data(),   pl.shiftVec.data(), pl.history.data(),
+            cs.table.data(),   cs.nMaterials,   uniformForceLaw(cs.table.data(), cs.table.size()),
+            !cs.attraction,    dt};
+}
 
 /// Particle i's own data, loaded once for all its pairs.
 template <int D>
@@ -413,7 +421,7 @@ template <int D, class Tangential, bool kCross>
             nl += touching;
             ne += touching;
         }
-        bl.ownerEnd[i - b0] = ne;
+        if constexpr (kCross) bl.ownerEnd[i - b0] = ne;
     }
     bl.reach = std::max<std::size_t>(std::size_t{last} + 1, b1);
     return nl;
@@ -472,16 +480,8 @@ template <int D, class Tangential>
 [[gnu::noinline]] std::uint32_t findTouchingLanes(const PairInputs<D>& in, const std::uint32_t* first,
                                                   std::size_t b0, std::size_t b1, PairBlock<D>& bl) {
     const std::uint32_t k0 = first[b0], n = first[b1] - k0;
-    std::uint32_t* own = bl.slotOwner.data();
-    // Eight at a time past each owner's end: the owners that follow overwrite what is not its own.
-    for (std::size_t i = b0; i < b1; ++i) {
-        const __m256i v = _mm256_set1_epi32(static_cast<int>(i));
-        for (std::uint32_t u = first[i] - k0; u < first[i + 1] - k0; u += 8)
-            _mm256_storeu_si256(reinterpret_cast<__m256i*>(own + u), v);
-    }
+    const std::uint32_t* own = in.owner + k0;
     const std::uint32_t* partner = in.partner;
-    std::uint8_t* gmask = bl.groupMask.data();
-    std::uint32_t* before = bl.groupBefore.data();
     std::uint32_t* outOwner = bl.owner.data();
     std::uint32_t* outPartner = bl.partner.data();
     std::uint32_t* outSlot = bl.slot.data();
@@ -490,16 +490,13 @@ template <int D, class Tangential>
     constexpr std::uint32_t kNoShift4 = 0x01010101u * PairList<D>::kNoShift;
     __m128i last = _mm_setzero_si128();
     std::uint32_t nl = 0, g = 0;
-    auto onePair = [&](std::uint32_t k, unsigned l, unsigned& m) {
+    auto onePair = [&](std::uint32_t k) {
         const std::uint32_t i = own[k - k0], j = partner[k];
         last = _mm_max_epu32(last, _mm_cvtsi32_si128(static_cast<int>(j)));
-        const bool t = testPair<D, Tangential>(in, bl, i, kernelVec(in.x[i]), in.radius[i], k, j, nl);
-        m |= unsigned{t} << l;
-        nl += t;
+        nl += testPair<D, Tangential>(in, bl, i, kernelVec(in.x[i]), in.radius[i], k, j, nl);
     };
     for (; 4 * g + 4 <= n; ++g) {
         const std::uint32_t k = k0 + 4 * g;
-        before[g] = nl;
         const std::uint32_t* ii = own + 4 * g;
         const std::uint32_t* jj = partner + k;
         const __m128i vi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ii));
@@ -526,7 +523,6 @@ template <int D, class Tangential>
         const __m256d rsum = _mm256_add_pd(ri, rj);
         const __m256d touch = _mm256_cmp_pd(dist2, _mm256_mul_pd(rsum, rsum), _CMP_NGE_UQ);  // NaN: touching
         const unsigned m = static_cast<unsigned>(_mm256_movemask_pd(touch));
-        gmask[g] = static_cast<std::uint8_t>(m);
         const __m256i p64 = _mm256_load_si256(reinterpret_cast<const __m256i*>(kCompact.i64[m]));
         const __m128i p32 = _mm_load_si128(reinterpret_cast<const __m128i*>(kCompact.i32[m]));
         for (int c = 0; c < D; ++c)
@@ -552,17 +548,8 @@ template <int D, class Tangential>
         }
         nl += static_cast<std::uint32_t>(__builtin_popcount(m));
     }
-    // The last pairs, and a closing group that the owners' ends below may point into.
-    before[g] = nl;
-    unsigned m = 0;
-    for (std::uint32_t k = k0 + 4 * g, l = 0; k < k0 + n; ++k, ++l) onePair(k, l, m);
-    gmask[g] = static_cast<std::uint8_t>(m);
-    // Owner b0 + q's pairs end at its slot end s: the touching pairs before s.
-    for (std::size_t i = b0; i < b1; ++i) {
-        const std::uint32_t s = first[i + 1] - k0;
-        bl.ownerEnd[i - b0] = before[s / 4] + static_cast<std::uint32_t>(
-                                                  __builtin_popcount(gmask[s / 4] & ((1u << (s % 4)) - 1)));
-    }
+    // The last pairs.
+    for (std::uint32_t k = k0 + 4 * g; k < k0 + n; ++k) onePair(k);
     last = _mm_max_epu32(last, _mm_shuffle_epi32(last, 0x4E));
     last = _mm_max_epu32(last, _mm_shuffle_epi32(last, 0xB1));
     bl.reach = std::max<std::size_t>(std::size_t{static_cast<std::uint32_t>(_mm_cvtsi128_si32(last))} + 1, b1);
@@ -588,9 +575,6 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
     for (std::uint32_t m = 0; m < nl; m += kLanes ? 4 : 1) {
         if constexpr (kLanes) {
             const LaneIndex ii = loadIndex(owner + m), jj = loadIndex(partner + m);
-            LaneIndex cc;
-            for (int l = 0; l < 4; ++l)
-                cc[l] = static_cast<std::int32_t>(material[owner[m + l]] * nm + material[partner[m + l]]);
             LaneVec<D> d;
             for (int k = 0; k < D; ++k) {
                 Lanes::Values v;
@@ -600,9 +584,15 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
             LaneVec<D> xi = LaneVec<D>::zero();
             if constexpr (Tangential::kHasHistory) xi = gather(history, loadIndex(slot + m));
             // Mostly the four pairs share one material pair: its coefficients broadcast, not gathered.
-            const LanePairCoeffs c = (cc[1] == cc[0] && cc[2] == cc[0] && cc[3] == cc[0])
-                                         ? LanePairCoeffs(in.table[cc[0]])
-                                         : LanePairCoeffs(in.table, cc);
+            auto coeffs = [&]() __attribute__((always_inline)) {
+                if (in.uniform) return LanePairCoeffs(in.table[0]);
+                LaneIndex cc;
+                for (int l = 0; l < 4; ++l)
+                    cc[l] = static_cast<std::int32_t>(material[owner[m + l]] * nm + material[partner[m + l]]);
+                return (cc[1] == cc[0] && cc[2] == cc[0] && cc[3] == cc[0]) ? LanePairCoeffs(in.table[cc[0]])
+                                                                            : LanePairCoeffs(in.table, cc);
+            };
+            const LanePairCoeffs c = coeffs();
             LaneVec<D> f;
             LaneVec<A> nxft;
             Lanes vir, overlap;
@@ -729,10 +719,14 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
                 }
                 evalTouching<D, Normal, Tangential, kCrossBlock, kLanes>(in, bl, padded);
             }
-            // (3) The sums, in pair order, and each particle finished.
+            // (3) The sums, in pair order, and each particle finished. Without cross pairs a particle's touching
+            // pairs are the next ones with it as owner (the list ends with kNoOwner); with them, the entries up to
+            // ownerEnd.
+            if constexpr (!kCrossBlock) bl.owner[nl] = Block::kNoOwner;
             const typename Block::Entry* out = bl.out.data();
             const std::uint32_t* outPartner = bl.outPartner.data();
             const std::uint32_t* partner = bl.partner.data();
+            const std::uint32_t* owner = bl.owner.data();
             // Every particle that the block's pairs add to starts here, once for the block.
             startUpTo(bl.reach);
             std::uint32_t t = 0;
@@ -742,7 +736,8 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
                 KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
                 double worst = 0, vir = 0;
                 std::uint32_t nc = 0;
-                for (const std::uint32_t tEnd = bl.ownerEnd[i - b0]; t < tEnd; ++t) {
+                const std::uint32_t tEnd = kCrossBlock ? bl.ownerEnd[i - b0] : 0;
+                for (; kCrossBlock ? t < tEnd : owner[t] == static_cast<std::uint32_t>(i); ++t) {
                     const typename Block::Entry& x = out[t];
                     const KernelVec<D> pf = rowVec<D>(x.a.c);
                     const KernelVec<kAngDim<D>> pn = rowVec<kAngDim<D>>(x.b.c);
@@ -799,10 +794,8 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
                          double time, double dt, const Vec<D>* sv, const Ang<D>* sw, ForceScratch<D>& s,
                          Then then) {
     const std::size_t n = p.tdmCount();
-    const PairInputs<D> in{p.x.data(),        p.v.data(),      p.w.data(),       p.radius.data(),
-                           p.invMass.data(),  p.material.data(), sv,             sw,
-                           pl.partner.data(), pl.shift.data(), pl.shiftVec.data(), pl.history.data(),
-                           cs.table.data(),   cs.nMaterials,   !cs.attraction,   dt};
+    if constexpr (kLanes) pl.makeOwners();
+    const PairInputs<D> in = pairInputs(p, pl, cs, sv, sw, dt);
     const std::uint32_t* first = pl.first.data();
     Vec<D>* wh = wallHistory.data();
     const Wall<D>* wp = walls.data();
