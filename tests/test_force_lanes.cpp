@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -52,8 +53,10 @@ temperature = 0.1
     return parseScenario(text, file);
 }
 
+/// oneLaw: every material pair gets the first pair's coefficients, so the lanes take the table's first entry for
+/// every contact (uniformForceLaw) while the one-by-one loop still looks each pair's entry up.
 template <int D, class Normal>
-void expectLanesMatchOneByOne(const Scenario& sc, int threads) {
+void expectLanesMatchOneByOne(const Scenario& sc, int threads, bool oneLaw = false) {
     World<D> w = buildWorld<D>(sc);
     ASSERT_EQ(w.contact.nMaterials, 2);
     TdmEngine<D> eng(w, tdmSettings<D>(sc, w));
@@ -65,6 +68,9 @@ void expectLanesMatchOneByOne(const Scenario& sc, int threads) {
         cs.table[m].dissipationTime = 1e-6 * (1.0 + double(m));
         cs.table[m].tsujiAlpha = 0.2 + 0.1 * double(m);
     }
+    if (oneLaw)
+        for (PairCoeffs& c : cs.table) c = cs.table[0];
+    ASSERT_EQ(uniformForceLaw(cs.table.data(), cs.table.size()), oneLaw);
     const int before = omp_get_max_threads();
     omp_set_num_threads(threads);
     auto run = [&](auto lanes, Particles<D>& p, PairList<D>& pl, std::vector<Vec<D>>& wh) {
@@ -120,6 +126,29 @@ TEST(ForceLanes, HertzSameBitsAsOneByOne) {
     const Scenario s2 = twoMaterialGas("threads2d.toml");
     expectLanesMatchOneByOne<2, HertzViscoNormal>(s2, 2);
     expectLanesMatchOneByOne<2, HertzTsujiNormal>(s2, 1);
+}
+
+TEST(ForceLanes, OneLawForAllPairsSameBitsAsOneByOne) {
+    expectLanesMatchOneByOne<3, LinearNormal>(twoMaterialGas("threads3d.toml"), 1, true);
+    expectLanesMatchOneByOne<2, LinearNormal>(twoMaterialGas("threads2d.toml"), 2, true);
+}
+
+TEST(ForceLanes, UniformForceLawComparesTheForceCoefficientsOnly) {
+    PairCoeffs a;
+    a.knConst = 2e5;
+    a.gtPerMeff = 25;
+    a.mu = 0.5;
+    std::vector<PairCoeffs> t(4, a);
+    EXPECT_TRUE(uniformForceLaw(t.data(), t.size()));
+    t[3].restitution = 0.3;  // the collision operator's view, not the force law
+    t[3].beta0 = 0.2;
+    EXPECT_TRUE(uniformForceLaw(t.data(), t.size()));
+    t[2].mu = 0.6;
+    EXPECT_FALSE(uniformForceLaw(t.data(), t.size()));
+    t[2].mu = 0.5;
+    t[1].knConst = std::nextafter(2e5, 1e6);  // the next double: not the same bits
+    EXPECT_FALSE(uniformForceLaw(t.data(), t.size()));
+    EXPECT_TRUE(uniformForceLaw(t.data(), 1));
 }
 
 }  // namespace
