@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -131,6 +132,39 @@ TEST(ForceLanes, HertzSameBitsAsOneByOne) {
 TEST(ForceLanes, OneLawForAllPairsSameBitsAsOneByOne) {
     expectLanesMatchOneByOne<3, LinearNormal>(twoMaterialGas("threads3d.toml"), 1, true);
     expectLanesMatchOneByOne<2, LinearNormal>(twoMaterialGas("threads2d.toml"), 2, true);
+}
+
+// A non-finite velocity reaches the forces of the particle and its partners in the same evaluation, an infinite
+// position the particle's own test: the pass reports the first particle concerned, in both ways of evaluating.
+TEST(ForceLanes, NonFiniteStateIsReported) {
+    const Scenario sc = twoMaterialGas("threads3d.toml");
+    World<3> w = buildWorld<3>(sc);
+    TdmEngine<3> eng(w, tdmSettings<3>(sc, w));
+    for (int k = 0; k < 100; ++k) eng.step();
+    const PairList<3>& pairs = eng.pairs();
+    std::size_t touching = ForceStats::kNone;  // owner of the first pair with a spring
+    for (std::size_t i = 0; i + 1 < pairs.first.size() && touching == ForceStats::kNone; ++i)
+        for (std::uint32_t k = pairs.first[i]; k < pairs.first[i + 1]; ++k)
+            if (norm2(pairs.history[k]) > 0) touching = i;
+    ASSERT_NE(touching, ForceStats::kNone);
+    const std::size_t last = w.particles.tdmCount() - 1;
+    for (int kind = 0; kind < 2; ++kind) {
+        auto run = [&](auto lanes) {
+            Particles<3> p = w.particles;
+            if (kind == 0) p.v[touching][1] = std::numeric_limits<double>::quiet_NaN();
+            else p.x[last][2] = std::numeric_limits<double>::infinity();
+            PairList<3> pl = pairs;
+            std::vector<Vec<3>> wh(p.tdmCount() * w.walls.size(), Vec<3>::zero());
+            ForceScratch<3> s;
+            auto none = [](std::size_t, const Vec<3>&, const Ang<3>&) {};
+            return computeForces<3, LinearNormal, SpringTangential, decltype(lanes)::value>(
+                p, pl, w.walls, wh, w.contact, w.domain, w.time, 1e-6, p.v.data(), p.w.data(), s, none);
+        };
+        const ForceStats a = run(std::true_type{}), b = run(std::false_type{});
+        EXPECT_EQ(a.nonFinite, b.nonFinite);
+        if (kind == 0) EXPECT_LE(a.nonFinite, touching);
+        else EXPECT_EQ(a.nonFinite, last);
+    }
 }
 
 TEST(ForceLanes, UniformForceLawComparesTheForceCoefficientsOnly) {

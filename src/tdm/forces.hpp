@@ -262,7 +262,12 @@ template <int N>
 }
 inline bool allFinite(const Wide3& v) {
     const Wide3::Lanes z = v.l - v.l;
+#ifdef __AVX__
+    // One compare of the lanes with zero (false for NaN) and its sign bits.
+    return (_mm256_movemask_pd(_mm256_cmp_pd(z, _mm256_setzero_pd(), _CMP_EQ_OQ)) & 7) == 7;
+#else
     return (z[0] == 0) & (z[1] == 0) & (z[2] == 0);
+#endif
 }
 
 /// Particle i's pair sums are complete (f: force, nx: sum of n x F_t): adds its wall contacts (in wall order),
