@@ -182,15 +182,30 @@ struct Owner {
           coeffRow(in.table + in.material[i] * in.nMaterials) {}
 };
 
+/// What the law reads of the two sides' motion: dv = v_i - v_j, wr = w_i r_i + w_j r_j, and the same of the mean
+/// velocities over the step (dsv, swr; the tangential spring's increment). Combined as soon as they are loaded, so
+/// that four pairs' kinematics take half the registers.
+template <class V, class A>
+struct RelMotion {
+    V dv;
+    A wr;
+    V dsv;
+    A swr;
+};
+template <class S, class V, class A>
+[[gnu::always_inline]] inline RelMotion<V, A> relMotion(const V& vi, const V& vj, const A& wi, const A& wj, const V& svi,
+                                                        const V& svj, const A& swi, const A& swj, S ri, S rj) {
+    return {vi - vj, wi * ri + wj * rj, svi - svj, swi * ri + swj * rj};
+}
+
 /// The contact law of a touching pair, from the pair's separation d = x_i - x_j (+ shift), |d|^2, radii, inverse
 /// masses and velocities: F on i, n x F_t and the spring xi (updated), r . F and overlap / smaller radius.
 /// Written once for one pair (S = double) and for four in lanes (S = Lanes; core/lanes.hpp): the same operations
 /// in the same order, so a pair gets the same bits either way.
 template <class Normal, class Tangential, class C, class S, class V, class A>
 [[gnu::always_inline]] inline void contactLaw(const C& c, const V& d, S dist2, S ri, S rj, S invMi, S invMj,
-                                              const V& vi, const V& vj, const A& wi, const A& wj, const V& svi,
-                                              const V& svj, const A& swi, const A& swj, V& xi, bool clip,
-                                              double dt, V& f, A& nxft, S& virial, S& overlap) {
+                                              const RelMotion<V, A>& m, V& xi, bool clip, double dt, V& f, A& nxft,
+                                              S& virial, S& overlap) {
     const S rsum = ri + rj;
     const S dist = sqrtOf(dist2);
     const V nrm = d * (1.0 / dist);
@@ -198,15 +213,15 @@ template <class Normal, class Tangential, class C, class S, class V, class A>
     // A frozen particle has 1/m = 0: it acts as infinitely heavy. (Frozen-frozen pairs are never listed.)
     const S meff = 1.0 / (invMi + invMj);
     const S reff = ri * rj / rsum;
-    const V dv = vi - vj;
+    const V& dv = m.dv;
     const S gn = dot(dv, nrm);
     NormalResultOf<S> nr = Normal::eval(c, delta, -gn, meff, reff);
     if (clip) nr.fn = select(nr.fn < 0, S(0.0), nr.fn);
     f = nrm * nr.fn;
     if constexpr (Tangential::kHasHistory) {
         // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
-        const V gt = dv - nrm * gn - cross(wi * ri + wj * rj, nrm);
-        const V gs = svi - svj - cross(swi * ri + swj * rj, nrm);
+        const V gt = dv - nrm * gn - cross(m.wr, nrm);
+        const V gs = m.dsv - cross(m.swr, nrm);
         const V ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, xi, dt);
         f += ft;
         nxft = cross(nrm, ft);
@@ -237,9 +252,10 @@ template <int D, class Normal, class Tangential>
     V xi = V::zero();
     if constexpr (Tangential::kHasHistory) xi = kernelVec(in.history[k]);
     double vir, overlap;
-    contactLaw<Normal, Tangential>(a.coeffRow[in.material[j]], d, dist2, ri, rj, a.invMass, in.invMass[j], a.v,
-                                   kernelVec(in.v[j]), a.w, kernelVec(in.w[j]), a.sv, kernelVec(in.sv[j]), a.sw,
-                                   kernelVec(in.sw[j]), xi, in.clip, in.dt, out.f, out.nxft, vir, overlap);
+    contactLaw<Normal, Tangential>(a.coeffRow[in.material[j]], d, dist2, ri, rj, a.invMass, in.invMass[j],
+                                   relMotion(a.v, kernelVec(in.v[j]), a.w, kernelVec(in.w[j]), a.sv,
+                                             kernelVec(in.sv[j]), a.sw, kernelVec(in.sw[j]), ri, rj),
+                                   xi, in.clip, in.dt, out.f, out.nxft, vir, overlap);
     if constexpr (Tangential::kHasHistory) in.history[k] = storedVec(xi);
     virial += vir;
     overlapRatio = std::max(overlapRatio, overlap);
@@ -601,11 +617,17 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
             LaneVec<D> f;
             LaneVec<A> nxft;
             Lanes vir, overlap;
-            contactLaw<Normal, Tangential>(c, d, norm2(d), gather(in.radius, ii), gather(in.radius, jj),
-                                           gather(in.invMass, ii), gather(in.invMass, jj), gather(in.v, ii),
-                                           gather(in.v, jj), gather(in.w, ii), gather(in.w, jj), gather(in.sv, ii),
-                                           gather(in.sv, jj), gather(in.sw, ii), gather(in.sw, jj), xi, in.clip,
-                                           in.dt, f, nxft, vir, overlap);
+            const Lanes ri = gather(in.radius, ii), rj = gather(in.radius, jj);
+            // Each side's kinematics combined as soon as loaded (relMotion, in the same order).
+            RelMotion<LaneVec<D>, LaneVec<A>> rel;
+            rel.dv = gather(in.v, ii) - gather(in.v, jj);
+            if constexpr (Tangential::kHasHistory) {
+                rel.wr = gather(in.w, ii) * ri + gather(in.w, jj) * rj;
+                rel.dsv = gather(in.sv, ii) - gather(in.sv, jj);
+                rel.swr = gather(in.sw, ii) * ri + gather(in.sw, jj) * rj;
+            }
+            contactLaw<Normal, Tangential>(c, d, norm2(d), ri, rj, gather(in.invMass, ii), gather(in.invMass, jj),
+                                           rel, xi, in.clip, in.dt, f, nxft, vir, overlap);
             // Back to rows, one per pair: the spring, then the entry.
             const Lanes zero(0.0);
             Row r[4];
@@ -635,11 +657,13 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
             V f;
             KernelVec<A> nxft;
             double vir, overlap;
-            contactLaw<Normal, Tangential>(in.table[material[i] * nm + material[j]], d, norm2(d), in.radius[i], in.radius[j],
-                                           in.invMass[i], in.invMass[j], kernelVec(in.v[i]), kernelVec(in.v[j]),
-                                           kernelVec(in.w[i]), kernelVec(in.w[j]), kernelVec(in.sv[i]),
-                                           kernelVec(in.sv[j]), kernelVec(in.sw[i]), kernelVec(in.sw[j]), xi,
-                                           in.clip, in.dt, f, nxft, vir, overlap);
+            contactLaw<Normal, Tangential>(
+                in.table[material[i] * nm + material[j]], d, norm2(d), in.radius[i], in.radius[j], in.invMass[i],
+                in.invMass[j],
+                relMotion(kernelVec(in.v[i]), kernelVec(in.v[j]), kernelVec(in.w[i]), kernelVec(in.w[j]),
+                          kernelVec(in.sv[i]), kernelVec(in.sv[j]), kernelVec(in.sw[i]), kernelVec(in.sw[j]),
+                          in.radius[i], in.radius[j]),
+                xi, in.clip, in.dt, f, nxft, vir, overlap);
             if constexpr (Tangential::kHasHistory) history[slot[m]] = storedVec(xi);
             Entry& o = out[kCross ? entry[m] : m];
             storeRow<D>(o.a.c, f);
