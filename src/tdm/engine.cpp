@@ -59,7 +59,7 @@ void TdmEngine<D>::computeForces(bool correct, std::atomic<bool>* nextMoved) {
                                            nextMoved));
             corrected = true;
         } else if (correct && verlet_) {
-            forces(verlet_->corrector(w_.particles, s_.dt));
+            forces(verlet_->corrector(w_.particles, s_.dt, motion_));
             corrected = true;
         } else {
             forces([](std::size_t, const Vec<D>&, const Ang<D>&) {});
@@ -77,7 +77,7 @@ void TdmEngine<D>::computeForces(bool correct, std::atomic<bool>* nextMoved) {
         withTangential(HertzTsujiNormal{});
     else
         withTangential(HertzViscoNormal{});  // A* = 0 is the undamped Hertz law
-    if (correct && !corrected) integ_->correct(w_.particles, s_.dt);
+    if (correct && !corrected) integ_->correct(w_.particles, s_.dt, motion_);
 }
 
 template <int D>

@@ -32,16 +32,9 @@ static void restartNew(I& integ, const P& p, const std::vector<std::uint32_t>& f
 
 // ---- velocity Verlet ----
 
+// The state is the store's: nothing to start, reorder or restart.
 template <int D>
-void VelocityVerlet<D>::start(const Particles<D>& p, double) {
-    const std::size_t n = p.tdmCount();
-    acc_.resize(n);
-    alpha_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        acc_[i] = p.f[i] * p.invMass[i];
-        alpha_[i] = p.torque[i] * p.invInertia[i];
-    }
-}
+void VelocityVerlet<D>::start(const Particles<D>&, double) {}
 
 template <int D>
 typename VelocityVerlet<D>::Predictor VelocityVerlet<D>::predictor(Particles<D>& p, double dt, StepMotion<D>& m,
@@ -49,8 +42,9 @@ typename VelocityVerlet<D>::Predictor VelocityVerlet<D>::predictor(Particles<D>&
     const std::size_t n = p.tdmCount();
     m.v.resize(n);
     m.w.resize(n);
-    return {p.x.data(), p.v.data(),     p.angle.data(), p.w.data(),     m.v.data(), m.w.data(),
-            acc_.data(), alpha_.data(), p.flags.data(), ref,            dt,         limit2};
+    return {p.x.data(),       p.v.data(),          p.angle.data(), p.w.data(), m.v.data(), m.w.data(),
+            p.f.data(),       p.torque.data(),     p.invMass.data(), p.invInertia.data(),
+            p.flags.data(),   ref,                 dt,             limit2};
 }
 
 template <int D>
@@ -65,12 +59,14 @@ bool VelocityVerlet<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, co
     Ang<D>* __restrict w = pr.w;
     Vec<D>* __restrict mv = pr.mv;
     Ang<D>* __restrict mw = pr.mw;
-    const Vec<D>* __restrict acc = pr.acc;
-    const Ang<D>* __restrict alpha = pr.alpha;
+    const Vec<D>* __restrict f = pr.f;
+    const Ang<D>* __restrict torque = pr.torque;
+    const double* __restrict invMass = pr.invMass;
+    const double* __restrict invInertia = pr.invInertia;
     const std::uint8_t* __restrict flags = pr.flags;
 #pragma omp parallel for schedule(static) reduction(|| : moved) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i)
-        moved |= Predictor::one(i, x, v, ang, w, mv, mw, acc, alpha, flags, ref, dt, limit2);
+        moved |= Predictor::one(i, x, v, ang, w, mv, mw, f, torque, invMass, invInertia, flags, ref, dt, limit2);
     return moved;
 }
 
@@ -91,34 +87,32 @@ inline V4 splat(double s) { return V4{s, s, s, s}; }
 template <int W, int R>
 inline constexpr V4i kSpread = {(4 * R) / W, (4 * R + 1) / W, (4 * R + 2) / W, (4 * R + 3) / W};
 
-/// Velocity Verlet on four particles' W-component quantity (position, velocity, acceleration, mean velocity,
-/// force; or angle, spin, ...): Corrector then Predictor element by element; frozen particles (fz) keep
-/// everything and get mv = v. With ref (positions), sq gets the squares of (new position - ref) element by element.
+/// Velocity Verlet on four particles' W-component quantity (position, velocity, mean velocity, force; or angle,
+/// spin, ...): Corrector then Predictor element by element; frozen particles (fz) keep everything and get mv = v.
+/// With ref (positions), sq gets the squares of (new position - ref) element by element.
 template <int W, bool kAnyFrozen, bool kDrift = false>
-[[gnu::always_inline]] inline void correctPredict4(const double* f, double* x, double* v, double* acc, double* mv,
-                                                    V4 scale, V4i fz, double dt, double h, double h2,
+[[gnu::always_inline]] inline void correctPredict4(const double* f, double* x, double* v, double* mv, V4 scale,
+                                                    V4i fz, double dt, double h, double h2,
                                                     const double* ref = nullptr, V4* sq = nullptr) {
     [&]<int... R>(std::integer_sequence<int, R...>) {
         (
             [&] {
                 const V4 s = __builtin_shuffle(scale, kSpread<W, R>);
-                const V4 x0 = load4(x + 4 * R), v0 = load4(v + 4 * R), a0 = load4(acc + 4 * R);
+                const V4 x0 = load4(x + 4 * R), mv0 = load4(mv + 4 * R);
                 const V4 a = load4(f + 4 * R) * s;
-                const V4 vi = v0 + (a - a0) * splat(h);  // the corrector: v(t + dt)
-                V4 mvn = vi + a * splat(0.5 * dt);         // the predictor of the next step
+                const V4 vi = mv0 + a * splat(h);  // the corrector: v(t + dt)
+                V4 mvn = vi + a * splat(0.5 * dt);  // the predictor of the next step
                 V4 xn = x0 + (vi * splat(dt) + a * splat(h2));
                 V4 vn = vi + a * splat(dt);
-                V4 an = a;
                 if constexpr (kAnyFrozen) {
                     const V4i z = __builtin_shuffle(fz, kSpread<W, R>);
+                    const V4 v0 = load4(v + 4 * R);
                     xn = z ? x0 : xn;
                     vn = z ? v0 : vn;
-                    an = z ? a0 : an;
                     mvn = z ? v0 : mvn;
                 }
                 store4(x + 4 * R, xn);
                 store4(v + 4 * R, vn);
-                store4(acc + 4 * R, an);
                 store4(mv + 4 * R, mvn);
                 if constexpr (kDrift) {
                     const V4 d = xn - load4(ref + 4 * R);
@@ -156,12 +150,11 @@ void VelocityVerlet<D>::CorrectPredict::finishBlock(std::size_t b, std::size_t e
     // Four particles, with (kAnyFrozen) or without the frozen ones blended back.
     auto four = [&]<bool kAnyFrozen>(V4i fz) {
         V4 sq[D];
-        correctPredict4<D, kAnyFrozen, true>(f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(),
-                                             correct.acc[i].c.data(), pr.mv[i].c.data(), load4(correct.invMass + i),
-                                             fz, dt, correct.h, h2, pr.ref[i].c.data(), sq);
-        correctPredict4<A, kAnyFrozen>(torque[i].c.data(), pr.ang[i].c.data(), pr.w[i].c.data(),
-                                       correct.alpha[i].c.data(), pr.mw[i].c.data(), load4(correct.invInertia + i),
-                                       fz, dt, correct.h, h2);
+        correctPredict4<D, kAnyFrozen, true>(pr.f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(),
+                                             pr.mv[i].c.data(), load4(correct.invMass + i), fz, dt, correct.h, h2,
+                                             pr.ref[i].c.data(), sq);
+        correctPredict4<A, kAnyFrozen>(pr.torque[i].c.data(), pr.ang[i].c.data(), pr.w[i].c.data(),
+                                       pr.mw[i].c.data(), load4(correct.invInertia + i), fz, dt, correct.h, h2);
         const V4i beyond = (norms4<D>(sq) > splat(pr.limit2)) & ~fz;
         far |= (beyond[0] | beyond[1] | beyond[2] | beyond[3]) != 0;
     };
@@ -177,42 +170,28 @@ void VelocityVerlet<D>::CorrectPredict::finishBlock(std::size_t b, std::size_t e
         }
     }
     for (; i < e; ++i) {
-        correct(i, f[i], torque[i]);
+        correct(i, pr.f[i], pr.torque[i]);
         far |= pr(i);
     }
     if (far) moved->store(true, std::memory_order_relaxed);
 }
 
 template <int D>
-void VelocityVerlet<D>::correct(Particles<D>& p, double dt) {
+void VelocityVerlet<D>::correct(Particles<D>& p, double dt, const StepMotion<D>& m) {
     const std::size_t n = p.tdmCount();
-    const Corrector c = corrector(p, dt);
+    const Corrector c = corrector(p, dt, m);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) c(i, p.f[i], p.torque[i]);
 }
 
 template <int D>
-void VelocityVerlet<D>::permute(const std::vector<std::uint32_t>& order) {
-    permuteVec(acc_, order);
-    permuteVec(alpha_, order);
-}
+void VelocityVerlet<D>::permute(const std::vector<std::uint32_t>&) {}
 
 template <int D>
-void VelocityVerlet<D>::remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) {
-    remapVec(acc_, from);
-    remapVec(alpha_, from);
-    restartNew(*this, p, from, dt);
-}
+void VelocityVerlet<D>::remap(const Particles<D>&, const std::vector<std::uint32_t>&, double) {}
 
 template <int D>
-void VelocityVerlet<D>::restart(const Particles<D>& p, std::size_t i, double) {
-    if (acc_.size() < p.tdmCount()) {
-        acc_.resize(p.tdmCount());
-        alpha_.resize(p.tdmCount());
-    }
-    acc_[i] = p.f[i] * p.invMass[i];
-    alpha_[i] = p.torque[i] * p.invInertia[i];
-}
+void VelocityVerlet<D>::restart(const Particles<D>&, std::size_t, double) {}
 
 // ---- Gear ----
 
@@ -309,7 +288,7 @@ bool Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D
 }
 
 template <int D>
-void Gear5<D>::correct(Particles<D>& p, double dt) {
+void Gear5<D>::correct(Particles<D>& p, double dt, const StepMotion<D>&) {
     const std::size_t n = p.tdmCount();
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {

@@ -29,7 +29,8 @@ public:
     /// Returns whether some particle is now farther than sqrt(limit2) from ref[i] (its position at the last
     /// pair-list build).
     virtual bool predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) = 0;
-    virtual void correct(Particles<D>& p, double dt) = 0;
+    /// m: the mean velocities the predict() of this step reported.
+    virtual void correct(Particles<D>& p, double dt, const StepMotion<D>& m) = 0;
     /// Reorders per-particle history after Particles::permute(order).
     virtual void permute(const std::vector<std::uint32_t>& order) = 0;
     /// Re-initialises the history of particle i from its current state and force (HAET mode switch).
@@ -40,12 +41,15 @@ public:
 };
 
 /// Velocity Verlet (Swope et al. 1982; F.2). Forces see v* = v + a(t) dt, the explicit estimate of v(t+dt).
+/// It keeps no state of its own: a(t) is the force the store holds over the mass (the predictor runs before the
+/// next force pass overwrites it), and the corrector starts from the half-step velocity v(t) + a(t) dt/2, which
+/// the predictor reports as the step's mean velocity: v(t+dt) = v(t + dt/2) + a(t+dt) dt/2.
 template <int D>
 class VelocityVerlet final : public Integrator<D> {
 public:
     void start(const Particles<D>& p, double dt) override;
     bool predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) override;
-    void correct(Particles<D>& p, double dt) override;
+    void correct(Particles<D>& p, double dt, const StepMotion<D>& m) override;
     void permute(const std::vector<std::uint32_t>& order) override;
     void restart(const Particles<D>& p, std::size_t i, double dt) override;
     void remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) override;
@@ -55,8 +59,8 @@ public:
     struct Corrector {
         Vec<D>* v;
         Ang<D>* w;
-        Vec<D>* acc;
-        Ang<D>* alpha;
+        const Vec<D>* mv;  ///< the step's mean velocities: v(t + dt/2)
+        const Ang<D>* mw;
         const double* invMass;
         const double* invInertia;
         const std::uint8_t* flags;
@@ -65,20 +69,18 @@ public:
             if (flags[i] & kFrozen) return;
             const Vec<D> a = f * invMass[i];
             const Ang<D> al = torque * invInertia[i];
-            v[i] += (a - acc[i]) * h;  // v(t+dt) = v(t) + (a(t) + a(t+dt)) dt/2
-            w[i] += (al - alpha[i]) * h;
-            acc[i] = a;
-            alpha[i] = al;
+            v[i] = mv[i] + a * h;  // v(t+dt) = v(t + dt/2) + a(t+dt) dt/2
+            w[i] = mw[i] + al * h;
         }
     };
-    Corrector corrector(Particles<D>& p, double dt) {
-        return {p.v.data(),       p.w.data(),          acc_.data(),      alpha_.data(),
-                p.invMass.data(), p.invInertia.data(), p.flags.data(),   0.5 * dt};
+    Corrector corrector(Particles<D>& p, double dt, const StepMotion<D>& m) {
+        return {p.v.data(),       p.w.data(),          m.v.data(),     m.w.data(),
+                p.invMass.data(), p.invInertia.data(), p.flags.data(), 0.5 * dt};
     }
 
     /// The predictor of one particle: position and angle to t + dt, velocities to v + a dt, the mean velocities
     /// over the step into m; returns whether the particle is now farther than sqrt(limit2) from ref[i].
-    /// predict() runs it over all particles.
+    /// predict() runs it over all particles. a(t): the force and torque in the store (of the last force pass).
     struct Predictor {
         Vec<D>* x;
         Vec<D>* v;
@@ -86,32 +88,38 @@ public:
         Ang<D>* w;
         Vec<D>* mv;
         Ang<D>* mw;
-        const Vec<D>* acc;
-        const Ang<D>* alpha;
+        const Vec<D>* f;
+        const Ang<D>* torque;
+        const double* invMass;
+        const double* invInertia;
         const std::uint8_t* flags;
         const Vec<D>* ref;
         double dt, limit2;
         [[gnu::always_inline]] bool operator()(std::size_t i) const {
-            return one(i, x, v, ang, w, mv, mw, acc, alpha, flags, ref, dt, limit2);
+            return one(i, x, v, ang, w, mv, mw, f, torque, invMass, invInertia, flags, ref, dt, limit2);
         }
         /// The predictor of particle i on the arrays given.
         [[gnu::always_inline]] static bool one(std::size_t i, Vec<D>* __restrict x, Vec<D>* __restrict v,
                                                Ang<D>* __restrict ang, Ang<D>* __restrict w, Vec<D>* __restrict mv,
-                                               Ang<D>* __restrict mw, const Vec<D>* __restrict acc,
-                                               const Ang<D>* __restrict alpha, const std::uint8_t* __restrict flags,
-                                               const Vec<D>* __restrict ref, double dt, double limit2) {
+                                               Ang<D>* __restrict mw, const Vec<D>* __restrict f,
+                                               const Ang<D>* __restrict torque, const double* __restrict invMass,
+                                               const double* __restrict invInertia,
+                                               const std::uint8_t* __restrict flags, const Vec<D>* __restrict ref,
+                                               double dt, double limit2) {
             if (flags[i] & kFrozen) {
                 mv[i] = v[i];
                 mw[i] = w[i];
                 return false;
             }
             const double h2 = 0.5 * dt * dt;
-            mv[i] = v[i] + acc[i] * (0.5 * dt);  // v(t + dt/2)
-            mw[i] = w[i] + alpha[i] * (0.5 * dt);
-            x[i] += v[i] * dt + acc[i] * h2;
-            v[i] += acc[i] * dt;
-            ang[i] += w[i] * dt + alpha[i] * h2;
-            w[i] += alpha[i] * dt;
+            const Vec<D> a = f[i] * invMass[i];  // a(t), as the corrector had it
+            const Ang<D> al = torque[i] * invInertia[i];
+            mv[i] = v[i] + a * (0.5 * dt);  // v(t + dt/2)
+            mw[i] = w[i] + al * (0.5 * dt);
+            x[i] += v[i] * dt + a * h2;
+            v[i] += a * dt;
+            ang[i] += w[i] * dt + al * h2;
+            w[i] += al * dt;
             return norm2(x[i] - ref[i]) > limit2;
         }
     };
@@ -127,9 +135,7 @@ public:
     /// tests. *moved becomes true when some particle moved beyond the predictor's limit; safe from several threads.
     struct CorrectPredict {
         Corrector correct;
-        Predictor predict;
-        const Vec<D>* f;
-        const Ang<D>* torque;
+        Predictor predict;  ///< its f and torque: the new forces (this step's, the next step's a(t))
         std::atomic<bool>* moved;
         /// Nothing per particle: the block does it.
         void operator()(std::size_t, const Vec<D>&, const Ang<D>&) const {}
@@ -137,12 +143,9 @@ public:
     };
     CorrectPredict correctPredict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2,
                                   std::atomic<bool>* moved) {
-        return {corrector(p, dt), predictor(p, dt, m, ref, limit2), p.f.data(), p.torque.data(), moved};
+        const Predictor pr = predictor(p, dt, m, ref, limit2);  // sizes m first
+        return {corrector(p, dt, m), pr, moved};
     }
-
-private:
-    std::vector<Vec<D>> acc_;    ///< a(t) [m/s^2]
-    std::vector<Ang<D>> alpha_;  ///< angular acceleration at t [rad/s^2]
 };
 
 /// Gear predictor-corrector with 6 values (F.1), corrector coefficients for velocity-dependent forces
@@ -154,7 +157,7 @@ public:
 
     void start(const Particles<D>& p, double dt) override;
     bool predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D>* ref, double limit2) override;
-    void correct(Particles<D>& p, double dt) override;
+    void correct(Particles<D>& p, double dt, const StepMotion<D>& m) override;
     void permute(const std::vector<std::uint32_t>& order) override;
     void restart(const Particles<D>& p, std::size_t i, double dt) override;
     void remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) override;
