@@ -723,6 +723,8 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
     for (std::size_t b0 = b, b1; b0 < e; b0 = b1) {
         b1 = b0 + 1;
         while (b1 < e && b1 - b0 < Block::kOwners && first[b1 + 1] - first[b0] <= Block::kPairs) ++b1;
+        // A whole number of fours (but for the range's last block): the step on the block goes four at a time.
+        if (b1 < e && b1 - b0 >= 4) b1 = b0 + ((b1 - b0) & ~std::size_t{3});
         bl.fit(first[b1] - first[b0]);
         // The block's three steps; kCrossBlock: some of its pairs are cross pairs (their partner lies beyond e),
         // taken from their slots in pair order, so the tests go one pair at a time.
