@@ -557,6 +557,23 @@ TEST(EdmEngine, DefaultCellsOfDiluteGas) {
     EXPECT_NEAR(eng.cellSize(), 2 * g.radius, 0.15 * g.radius);
 }
 
+// A particle joining the engine (from the time-driven side of a hybrid run) is checked as the constructor checks
+// every particle: its material must be in the contact table.
+TEST(EdmEngine, JoiningParticleNeedsAMaterialOfTheTable) {
+    World<3> w = bouncingBall(0.5);
+    w.particles.add(Vec<3>{{0.5, 0.5, 0.8}}, Vec<3>::zero(), Ang<3>::zero(), 0.05, 1000, 0, 1);
+    EdmSettings s;
+    s.firstParticle = 1;  // particle 0 belongs to another engine
+    EdmEngine<3> eng(w, s);
+    EXPECT_FALSE(eng.owns(0));
+    w.particles.material[0] = static_cast<std::uint16_t>(w.contact.nMaterials);
+    EXPECT_THROW(eng.add(0, 0.0), std::invalid_argument);
+    EXPECT_FALSE(eng.owns(0));
+    w.particles.material[0] = 0;
+    eng.add(0, 0.0);
+    EXPECT_TRUE(eng.owns(0));
+}
+
 TEST(EdmEngine, RejectsBadSettings) {
     World<3> w = bouncingBall(0.5);
     EdmSettings s;

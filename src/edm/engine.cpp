@@ -1521,6 +1521,8 @@ void EdmEngine<D>::add(std::size_t i, double t) {
     if (owns(i) || i >= p.size()) throw std::logic_error("event-driven engine: add of an owned or unknown particle");
     if (free_.empty()) throw std::logic_error("event-driven engine: no free slot");
     if (p.radius[i] > rmax_ * (1 + 1e-12)) throw std::logic_error("event-driven engine: particle larger than the grid");
+    if (p.material[i] >= w_.contact.nMaterials)
+        throw std::invalid_argument("event-driven engine: particle material outside the contact table");
     const std::uint32_t s = free_.back();
     free_.pop_back();
     wrapIntoBox(i);
