@@ -636,9 +636,9 @@ template <int D>
     for (int l = 0; l < 4; ++l) {
         double tl = t[l];
         if (special[l]) {
-            Shift ml;
-            const Shift w = wrapsOf(bt.wrap[l]);
-            for (int k = 0; k < D; ++k) ml[k] = (*bt.base[l])[k] + w[k];
+            Shift ml{};  // a plain batch's shifts are zero
+            if (!plain)
+                for (int k = 0; k < D; ++k) ml[k] = m[k][l];
             tl = candidateTime(hs, s, j[l], ml, now, best.time);
         }
         const std::uint32_t code = (kPair << kTypeShift) | j[l];
