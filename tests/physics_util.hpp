@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -19,6 +20,12 @@ namespace haet::testing {
 /// A scene of tests/data/ (the same files `haet run` accepts).
 inline Scenario dataScenario(const std::string& name) {
     return loadScenario(std::filesystem::path(HAET_SOURCE_DIR) / "tests" / "data" / name);
+}
+
+/// Whether two arrays hold the same bits (not only equal values: -0 and 0, NaNs told apart).
+template <class T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
 /// A measured value in the test's XML report (--gtest_output=xml), to follow margins over time.

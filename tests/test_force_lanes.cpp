@@ -18,17 +18,14 @@
 #include "tdm/engine.hpp"
 #include "tdm/forces.hpp"
 #include "world/build.hpp"
+#include "physics_util.hpp"
 #include "scenario_text.hpp"
 
 namespace haet {
 namespace {
 
 using testing::replaced;
-
-template <class T>
-bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+using testing::sameBits;
 
 /// threadsXd.toml with 500 fewer particles, and 500 of a second material (other friction and restitution, other sizes).
 Scenario twoMaterialGas(const char* name) {

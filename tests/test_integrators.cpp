@@ -8,9 +8,12 @@
 
 #include "core/rng.hpp"
 #include "tdm/integrators.hpp"
+#include "physics_util.hpp"
 
 namespace haet {
 namespace {
+
+using testing::sameBits;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kW0 = 2 * kPi, kEta = 1.0;
@@ -74,12 +77,8 @@ TEST(Integrators, VerletConvergesAtSecondOrder) {
 // Velocity Verlet's corrector and next predictor four particles at a time (CorrectPredict::finishBlock, run by the
 // force pass on each block) against its twins, Corrector then Predictor one particle at a time: the same bits,
 // for blocks of every length 0..9 at every offset modulo 4, with frozen particles among them (which keep their
-// position and velocity and get the velocity as mean velocity), two steps in a row (the second reads the
-// accelerations the first stored).
-template <class T>
-bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+// position and velocity and get the velocity as mean velocity), two steps in a row (the second's corrector reads
+// the mean velocities the first's predictor stored).
 
 template <int D>
 void checkBlockStepMatchesTwins() {

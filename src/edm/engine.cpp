@@ -71,6 +71,12 @@ EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings) : w_(world
 // set-up
 
 template <int D>
+void EdmEngine<D>::requireKnownMaterial(std::size_t i) const {
+    if (w_.particles.material[i] >= w_.contact.nMaterials)
+        throw std::invalid_argument("event-driven engine: particle material outside the contact table");
+}
+
+template <int D>
 void EdmEngine<D>::reset() {
     Particles<D>& p = w_.particles;
     if (!p.hasMotion()) throw std::logic_error("event-driven engine: reset while it holds the state (synchronise first)");
@@ -82,8 +88,7 @@ void EdmEngine<D>::reset() {
     // Every particle sizes the grid (those of another engine may join later).
     for (std::size_t i = 0; i < n; ++i) {
         if (!(p.radius[i] > 0)) throw std::invalid_argument("event-driven engine: particle with radius <= 0");
-        if (p.material[i] >= w_.contact.nMaterials)
-            throw std::invalid_argument("event-driven engine: particle material outside the contact table");
+        requireKnownMaterial(i);
         rmax_ = std::max(rmax_, p.radius[i]);
         if (i >= first && !p.frozen(i)) ++nMoving_;
     }
@@ -1521,8 +1526,7 @@ void EdmEngine<D>::add(std::size_t i, double t) {
     if (owns(i) || i >= p.size()) throw std::logic_error("event-driven engine: add of an owned or unknown particle");
     if (free_.empty()) throw std::logic_error("event-driven engine: no free slot");
     if (p.radius[i] > rmax_ * (1 + 1e-12)) throw std::logic_error("event-driven engine: particle larger than the grid");
-    if (p.material[i] >= w_.contact.nMaterials)
-        throw std::invalid_argument("event-driven engine: particle material outside the contact table");
+    requireKnownMaterial(i);
     const std::uint32_t s = free_.back();
     free_.pop_back();
     wrapIntoBox(i);

@@ -326,6 +326,8 @@ private:
     Vec<D> velAt(const Hot& h, double t) const;
     bool frozen(std::uint32_t s) const { return hot_[s].t == kNever; }  // also true for a free slot
     CollisionLaw lawFor(int matA, int matB, bool elastic) const;
+    /// Throws std::invalid_argument unless World particle i's material is in the contact table.
+    void requireKnownMaterial(std::size_t i) const;
     /// Whether the collisions of a material pair have beta = -1 whatever the velocities (Walton's rule with
     /// mu = 0, or a constant beta0 = -1): no tangential impulse, so rotation is left alone.
     bool smoothPair(int matA, int matB) const;

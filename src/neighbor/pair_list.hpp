@@ -36,7 +36,7 @@ struct PairList {
     std::vector<Vec<D>> history;        ///< tangential spring of each pair [m]; zero when not touching
     std::vector<Vec<D>> shiftVec;       ///< 3^D shift vectors [m]
     // Made from the list when first needed, dropped by every change of the list (dropDerived):
-    ThreadSplit split;                  ///< the threaded disk force loop's split (buildThreadSplit)
+    ThreadSplit split;                  ///< the threaded force loops' split (buildThreadSplit)
     std::vector<std::uint32_t> owner;   ///< owner i of each pair (makeOwners), for the four-wide contact tests
 
     /// Forgets what was made from the list (after the list changed).
