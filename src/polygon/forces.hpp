@@ -356,25 +356,36 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
 
     if (pl.split.ranges() != static_cast<std::size_t>(nt)) buildThreadSplit(pl, nt);
     const ThreadSplit& sp = pl.split;
-    ps.cross.resize(sp.crossSlot.size());
+    const std::size_t ncross = sp.crossSlot.size();
+    ps.cross.resize(ncross);
+    ps.virial.resize(n);
+    ps.tally.assign(static_cast<std::size_t>(nt), RangeTally{});
     PolygonCrossPair* cross = ps.cross.data();
-    return runThreadSplit(
-        sp, nt, n, ps.virial, ps.tally,
-        [&](std::size_t c) __attribute__((always_inline)) {
+#pragma omp parallel num_threads(nt)
+    {
+        // The cross pairs first: every particle is still unfinished.
+#pragma omp for schedule(static)
+        for (std::size_t c = 0; c < ncross; ++c) {
             PolygonCrossPair& x = cross[c];
             const std::uint32_t k = sp.crossSlot[c];
             x.overlap = 0;
             x.virial = 0;
             x.touching = pair(sp.crossOwner[c], k, x.r, x.overlap, x.virial);
             ps.pairEnergy[k] = x.touching ? x.r.energy : 0.0;
-        },
-        [&](int r) __attribute__((always_inline)) {
+        }
+#pragma omp for schedule(static, 1)
+        for (int r = 0; r < nt; ++r) {
             const std::uint64_t* ci = sp.crossIn.data();
-            return polygonRange<Normal, Tangential, true>(p, pl, walls, wallHistory, cs, time, dt, sv, sw, ps,
-                                                         sp.start[r], sp.start[r + 1], cross, sp.crossFirst[r],
-                                                         ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1],
-                                                         ps.virial.data(), nullptr, pair);
-        });
+            ps.tally[r] = polygonRange<Normal, Tangential, true>(
+                p, pl, walls, wallHistory, cs, time, dt, sv, sw, ps, sp.start[r], sp.start[r + 1], cross,
+                sp.crossFirst[r], ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1], ps.virial.data(), nullptr,
+                pair);
+        }
+    }
+    // The one-thread reductions, in the same order.
+    for (const RangeTally& t : ps.tally) addTally(st, t);
+    for (std::size_t i = 0; i < n; ++i) st.virial += ps.virial[i];
+    return st;
 }
 
 }  // namespace haet::polygon

@@ -58,29 +58,6 @@ inline void addTally(ForceStats& st, const RangeTally& t) {
     if (st.nonFinite == ForceStats::kNone) st.nonFinite = t.nonFinite;
 }
 
-/// The threaded force pass over the T ranges of split (PairList::split): the cross pairs first, evalCross(c) for
-/// each, then runRange(r) for each range, in parallel; then the reductions in range and particle order, so that
-/// the result is the one-thread pass's. virial: one slot per particle, which runRange fills.
-template <class EvalCross, class RunRange>
-[[gnu::always_inline]] inline ForceStats runThreadSplit(const ThreadSplit& split, int nt, std::size_t n, std::vector<double>& virial,
-                          std::vector<RangeTally>& tally, EvalCross evalCross, RunRange runRange) {
-    const std::size_t ncross = split.crossSlot.size();
-    virial.resize(n);
-    tally.assign(static_cast<std::size_t>(nt), RangeTally{});
-#pragma omp parallel num_threads(nt)
-    {
-        // The cross pairs first: every particle is still unfinished.
-#pragma omp for schedule(static)
-        for (std::size_t c = 0; c < ncross; ++c) evalCross(c);
-#pragma omp for schedule(static, 1)
-        for (int r = 0; r < nt; ++r) tally[static_cast<std::size_t>(r)] = runRange(r);
-    }
-    ForceStats st;
-    for (const RangeTally& t : tally) addTally(st, t);
-    for (std::size_t i = 0; i < n; ++i) st.virial += virial[i];
-    return st;
-}
-
 /// What one pair adds to its owner (its partner gets -f and n x F_t): a cross pair evaluated before the ranges
 /// run (threaded path), or an entry of a PairBlock.
 template <int D>
@@ -216,8 +193,9 @@ struct RelMotion {
     A swr;
 };
 template <class S, class V, class A>
-[[gnu::always_inline]] inline RelMotion<V, A> relMotion(const V& vi, const V& vj, const A& wi, const A& wj, const V& svi,
-                                                        const V& svj, const A& swi, const A& swj, S ri, S rj) {
+[[gnu::always_inline]] inline RelMotion<V, A> relMotion(const V& vi, const V& vj, const A& wi, const A& wj,
+                                                        const V& svi, const V& svj, const A& swi, const A& swj, S ri,
+                                                        S rj) {
     return {vi - vj, wi * ri + wj * rj, svi - svj, swi * ri + swj * rj};
 }
 
@@ -869,11 +847,17 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
 
     if (pl.split.ranges() != static_cast<std::size_t>(nt)) buildThreadSplit(pl, nt);
     const ThreadSplit& sp = pl.split;
-    s.cross.resize(sp.crossSlot.size());
+    const std::size_t ncross = sp.crossSlot.size();
+    s.cross.resize(ncross);
+    s.virial.resize(n);
     CrossPair<D>* cross = s.cross.data();
-    return runThreadSplit(
-        sp, nt, n, s.virial, s.tally,
-        [&](std::size_t c) __attribute__((always_inline)) {
+    s.tally.assign(static_cast<std::size_t>(nt), RangeTally{});
+    RangeTally* tally = s.tally.data();
+#pragma omp parallel num_threads(nt)
+    {
+        // The cross pairs first: every particle is still unfinished.
+#pragma omp for schedule(static)
+        for (std::size_t c = 0; c < ncross; ++c) {
             const Owner<D> a(in, sp.crossOwner[c]);
             PairForce<D> pf;
             CrossPair<D>& x = cross[c];
@@ -884,14 +868,20 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
                 x.f = storedVec(pf.f);
                 x.nxft = storedVec(pf.nxft);
             }
-        },
-        [&](int r) __attribute__((always_inline)) {
+        }
+#pragma omp for schedule(static, 1)
+        for (int r = 0; r < nt; ++r) {
             const std::uint64_t* ci = sp.crossIn.data();
-            return forceRange<D, Normal, Tangential, true, kLanes>(
+            tally[r] = forceRange<D, Normal, Tangential, true, kLanes>(
                 p, in, first, wp, nw, wh, cs, time, g, sp.start[r], sp.start[r + 1], cross, sp.crossFirst[r],
                 ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1], s.virial.data(), nullptr,
                 s.blocks[static_cast<std::size_t>(r)], then);
-        });
+        }
+    }
+    // The one-thread reductions, in the same order.
+    for (const RangeTally& t : s.tally) addTally(st, t);
+    for (std::size_t i = 0; i < n; ++i) st.virial += s.virial[i];
+    return st;
 }
 
 }  // namespace haet
