@@ -78,10 +78,11 @@ TEST(Integrators, VerletConvergesAtSecondOrder) {
 // force pass on each block) against its twins, Corrector then Predictor one particle at a time: the same bits,
 // for blocks of every length 0..9 at every offset modulo 4, with frozen particles among them (which keep their
 // position and velocity and get the velocity as mean velocity), two steps in a row (the second's corrector reads
-// the mean velocities the first's predictor stored).
+// the mean velocities the first's predictor stored). With polygons (2D) the store keeps orientations, which are
+// held to the same bits too; without, it keeps none.
 
 template <int D>
-void checkBlockStepMatchesTwins() {
+void checkBlockStepMatchesTwins(bool polygons = false) {
     Rng rng(7, 3);
     auto u = [&] { return 2 * rng.uniform() - 1; };
     auto vec = [&]<int N>(Vec<N>) {
@@ -91,9 +92,18 @@ void checkBlockStepMatchesTwins() {
     };
     Particles<D> p;
     const std::size_t n = 47;
-    for (std::size_t i = 0; i < n; ++i)
-        p.add(vec(Vec<D>{}), vec(Vec<D>{}), vec(Ang<D>{}), 0.5 + 0.2 * rng.uniform(), 1000, 0, i,
-              (i % 5 == 2 || i == 9 || i == 10) ? kFrozen : 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint8_t flag = (i % 5 == 2 || i == 9 || i == 10) ? kFrozen : 0;
+        if constexpr (D == 2) {
+            if (polygons && i % 3 == 1) {
+                const std::vector<Vec<2>> square{{{-0.4, -0.4}}, {{0.4, -0.4}}, {{0.4, 0.4}}, {{-0.4, 0.4}}};
+                p.addPolygon(vec(Vec<D>{}), vec(Vec<D>{}), vec(Ang<D>{}), u(), square, 1000, 0, i, flag);
+                continue;
+            }
+        }
+        p.add(vec(Vec<D>{}), vec(Vec<D>{}), vec(Ang<D>{}), 0.5 + 0.2 * rng.uniform(), 1000, 0, i, flag);
+    }
+    ASSERT_EQ(p.angle.size(), polygons ? n : 0);
     for (std::size_t i = 0; i < n; ++i) {
         p.f[i] = vec(Vec<D>{});
         p.torque[i] = vec(Ang<D>{});
@@ -150,12 +160,14 @@ void checkBlockStepMatchesTwins() {
             EXPECT_TRUE(std::memcmp(&b.v[i], &p.v[i], sizeof(Vec<D>)) == 0) << i;
         } else {
             EXPECT_NE(b.x[i][0], p.x[i][0]) << i;
+            if (polygons) EXPECT_NE(b.angle[i][0], p.angle[i][0]) << i;
         }
     }
 }
 
 TEST(Integrators, VerletBlockStepMatchesOneParticleAtATime2D) { checkBlockStepMatchesTwins<2>(); }
 TEST(Integrators, VerletBlockStepMatchesOneParticleAtATime3D) { checkBlockStepMatchesTwins<3>(); }
+TEST(Integrators, VerletBlockStepMatchesOneParticleAtATimeWithOrientations) { checkBlockStepMatchesTwins<2>(true); }
 
 }  // namespace
 }  // namespace haet

@@ -50,11 +50,12 @@ struct Particles {
     std::vector<std::uint8_t> flags;      ///< ParticleFlag bits
     // cold
     std::vector<double> mass;     ///< [kg] (kept for frozen particles too, for contact effective mass)
-    std::vector<Ang<D>> angle;    ///< accumulated rotation angle [rad] (2D: orientation; empty without hasTdmState())
     std::vector<std::uint64_t> id;  ///< stable user-visible id (survives reordering)
     std::vector<Vec<D>> image;    ///< accumulated periodic wraps, for unwrapped positions [m]
-    // polygons (2D only). Empty while the store holds no polygon, so disk and sphere runs carry nothing extra.
+    // polygons (2D only). Empty while the store holds no polygon, so disk and sphere runs carry nothing extra:
+    // a disk or a sphere looks the same however it has turned, so only a polygon's orientation is kept.
     std::vector<std::uint32_t> shape;  ///< index into `shapes`, kNoShape for a disk
+    std::vector<Ang<D>> angle;         ///< orientation [rad], integrated from w (a disk's too, once polygons exist)
     ShapeTable shapes;                 ///< never permuted: particles point into it
 
     /// Particles [0, tdmCount()) are integrated by the time-driven engine. In a hybrid run the rest belong to the
@@ -62,16 +63,15 @@ struct Particles {
     std::size_t nTdm = static_cast<std::size_t>(-1);
 
     std::size_t size() const { return id.size(); }
-    /// Whether f, torque and angle are kept. Only the time-driven engine reads them (the hybrid too, for its
-    /// time-driven particles); a pure event-driven run applies impulses, not forces, and nothing reads the
-    /// accumulated rotation of a disk or sphere, so it drops them (dropTdmState): 72 of the 211 bytes per sphere.
+    /// Whether f and torque are kept. Only the time-driven engine reads them (the hybrid too, for its
+    /// time-driven particles); a pure event-driven run applies impulses, not forces, so it drops them
+    /// (dropTdmState): 48 of the 187 bytes per sphere.
     bool hasTdmState() const { return tdmState_; }
-    /// Frees f, torque and angle; particles added later get none either. For a pure event-driven run.
+    /// Frees f and torque; particles added later get none either. For a pure event-driven run.
     void dropTdmState() {
         tdmState_ = false;
         std::vector<Vec<D>>().swap(f);
         std::vector<Ang<D>>().swap(torque);
-        std::vector<Ang<D>>().swap(angle);
     }
     std::size_t tdmCount() const { return nTdm < size() ? nTdm : size(); }
 
@@ -104,7 +104,6 @@ struct Particles {
         if (tdmState_) {
             f.push_back(Vec<D>::zero());
             torque.push_back(Ang<D>::zero());
-            angle.push_back(Ang<D>::zero());
         }
         radius.push_back(r);
         mass.push_back(m);
@@ -115,7 +114,10 @@ struct Particles {
         flags.push_back(flag);
         id.push_back(pid);
         image.push_back(Vec<D>::zero());
-        if (!shape.empty()) shape.push_back(kNoShape);
+        if (!shape.empty()) {
+            shape.push_back(kNoShape);
+            angle.push_back(Ang<D>::zero());
+        }
         return x.size() - 1;
     }
 
@@ -153,7 +155,9 @@ struct Particles {
         }
         const double area = 0.5 * a2;
         const std::size_t i = add(pos, vel, spin, std::sqrt(r2), density, mat, pid, flag);
-        shape.resize(x.size(), kNoShape);  // the first polygon turns the disks before it into kNoShape entries
+        // The first polygon gives the disks before it kNoShape entries and orientations.
+        shape.resize(x.size(), kNoShape);
+        angle.resize(x.size(), Ang<D>::zero());
         const double m = density * area;
         const double ipm = (io / 12.0) / area;  // about the centroid, which is now the origin
         mass[i] = m;
@@ -189,8 +193,8 @@ struct Particles {
         auto sw = [&](auto& arr) { std::swap(arr[i], arr[j]); };
         sw(x); sw(v); sw(w); sw(radius); sw(invMass); sw(invInertia); sw(material); sw(flags); sw(mass); sw(id);
         sw(image);
-        if (tdmState_) { sw(f); sw(torque); sw(angle); }
-        if (!shape.empty()) sw(shape);
+        if (tdmState_) { sw(f); sw(torque); }
+        if (!shape.empty()) { sw(shape); sw(angle); }
     }
 
     /// Applies a permutation: new index k holds old particle order[k]. Used for spatial sorting. A shorter order
@@ -203,8 +207,8 @@ struct Particles {
         };
         apply(x); apply(v); apply(w); apply(radius); apply(invMass); apply(invInertia); apply(material);
         apply(flags); apply(mass); apply(id); apply(image);
-        if (tdmState_) { apply(f); apply(torque); apply(angle); }
-        if (!shape.empty()) apply(shape);
+        if (tdmState_) { apply(f); apply(torque); }
+        if (!shape.empty()) { apply(shape); apply(angle); }
     }
 
 private:

@@ -50,6 +50,8 @@ EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings) : w_(world
     if (!(s_.shell >= 0)) throw std::invalid_argument("event-driven engine: shell must be >= 0");
     if (s_.holdState && s_.firstParticle > 0)
         throw std::invalid_argument("event-driven engine: holdState needs every particle (firstParticle = 0)");
+    if (w_.particles.hasPolygons())
+        throw std::invalid_argument("event-driven engine: polygons are for the time-driven engine only");
     tcRef_ = s_.tcTime > 0 ? s_.tcTime : cs.contactTime;
     tc_ = (s_.tcModel && tcRef_ > 0) ? tcRef_ : 0;
     g_ = w_.domain.gravity;
@@ -385,9 +387,6 @@ void EdmEngine<D>::advance(std::uint32_t s, double t) {
     if (dt != 0) {
         h.x = posAt(h, t);
         h.v = velAt(h, t);
-        Particles<D>& p = w_.particles;
-        // Free rotation between collisions, when the store keeps angles (a pure event-driven run drops them).
-        if (p.hasTdmState()) p.angle[rec_[s].idx] += p.w[rec_[s].idx] * dt;
     }
     h.t = t;
 }

@@ -559,10 +559,12 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
     const std::size_t n = world.particles.size();
     const std::size_t pairs = eng.pairs().size();
     // Memory: particle arrays (x, v, f, image, mean velocity over the step, position at the list build; w, torque,
-    // angle, mean spin; radius, mass, 1/m, 1/I, id; list offset, material, flags) + integrator history (Gear's
-    // higher derivatives; velocity Verlet keeps none) + pair list (partner, owner, shift, spring).
+    // mean spin, and a polygon's orientation; radius, mass, 1/m, 1/I, id; list offset, material, flags) +
+    // integrator history (Gear's higher derivatives; velocity Verlet keeps none) + pair list (partner, owner,
+    // shift, spring).
     const std::size_t gearHistory = 4 * (sizeof(Vec<D>) + sizeof(Ang<D>));
-    const std::size_t perParticle = sizeof(Vec<D>) * 6 + sizeof(Ang<D>) * 4 + 8 * 5 + 8 +
+    const std::size_t perParticle = sizeof(Vec<D>) * 6 + sizeof(Ang<D>) * (world.particles.hasPolygons() ? 4 : 3) +
+                                    8 * 5 + 8 +
                                     (ts.integrator == IntegratorKind::Gear5 ? gearHistory : 0);
     const std::size_t perPair = 4 + 4 + 1 + sizeof(Vec<D>);
     const double steps = std::ceil(sc.duration / ts.dt);

@@ -42,7 +42,8 @@ typename VelocityVerlet<D>::Predictor VelocityVerlet<D>::predictor(Particles<D>&
     const std::size_t n = p.tdmCount();
     m.v.resize(n);
     m.w.resize(n);
-    return {p.x.data(),       p.v.data(),          p.angle.data(), p.w.data(), m.v.data(), m.w.data(),
+    Ang<D>* ang = p.angle.empty() ? nullptr : p.angle.data();
+    return {p.x.data(),       p.v.data(),          ang,            p.w.data(), m.v.data(), m.w.data(),
             p.f.data(),       p.torque.data(),     p.invMass.data(), p.invInertia.data(),
             p.flags.data(),   ref,                 dt,             limit2};
 }
@@ -89,8 +90,9 @@ inline constexpr V4i kSpread = {(4 * R) / W, (4 * R + 1) / W, (4 * R + 2) / W, (
 
 /// Velocity Verlet on four particles' W-component quantity (position, velocity, mean velocity, force; or angle,
 /// spin, ...): Corrector then Predictor element by element; frozen particles (fz) keep everything and get mv = v.
-/// With ref (positions), sq gets the squares of (new position - ref) element by element.
-template <int W, bool kAnyFrozen, bool kDrift = false>
+/// With ref (positions), sq gets the squares of (new position - ref) element by element. Without kPos only the
+/// velocities (the spin of a particle whose orientation is not kept).
+template <int W, bool kAnyFrozen, bool kDrift = false, bool kPos = true>
 [[gnu::always_inline]] inline void correctPredict4(const double* f, double* x, double* v, double* mv, V4 scale,
                                                     V4i fz, double dt, double h, double h2,
                                                     const double* ref = nullptr, V4* sq = nullptr) {
@@ -98,26 +100,29 @@ template <int W, bool kAnyFrozen, bool kDrift = false>
         (
             [&] {
                 const V4 s = __builtin_shuffle(scale, kSpread<W, R>);
-                const V4 x0 = load4(x + 4 * R), mv0 = load4(mv + 4 * R);
+                const V4 mv0 = load4(mv + 4 * R);
                 const V4 a = load4(f + 4 * R) * s;
                 const V4 vi = mv0 + a * splat(h);  // the corrector: v(t + dt)
                 V4 mvn = vi + a * splat(0.5 * dt);  // the predictor of the next step
-                V4 xn = x0 + (vi * splat(dt) + a * splat(h2));
                 V4 vn = vi + a * splat(dt);
                 if constexpr (kAnyFrozen) {
                     const V4i z = __builtin_shuffle(fz, kSpread<W, R>);
                     const V4 v0 = load4(v + 4 * R);
-                    xn = z ? x0 : xn;
                     vn = z ? v0 : vn;
                     mvn = z ? v0 : mvn;
                 }
-                store4(x + 4 * R, xn);
+                if constexpr (kPos) {
+                    const V4 x0 = load4(x + 4 * R);
+                    V4 xn = x0 + (vi * splat(dt) + a * splat(h2));
+                    if constexpr (kAnyFrozen) xn = __builtin_shuffle(fz, kSpread<W, R>) ? x0 : xn;
+                    store4(x + 4 * R, xn);
+                    if constexpr (kDrift) {
+                        const V4 d = xn - load4(ref + 4 * R);
+                        sq[R] = d * d;
+                    }
+                }
                 store4(v + 4 * R, vn);
                 store4(mv + 4 * R, mvn);
-                if constexpr (kDrift) {
-                    const V4 d = xn - load4(ref + 4 * R);
-                    sq[R] = d * d;
-                }
             }(),
             ...);
     }(std::make_integer_sequence<int, W>{});
@@ -147,28 +152,34 @@ void VelocityVerlet<D>::CorrectPredict::finishBlock(std::size_t b, std::size_t e
     const double dt = pr.dt, h2 = 0.5 * dt * dt;
     bool far = false;
     std::size_t i = b;
-    // Four particles, with (kAnyFrozen) or without the frozen ones blended back.
-    auto four = [&]<bool kAnyFrozen>(V4i fz) {
-        V4 sq[D];
-        correctPredict4<D, kAnyFrozen, true>(pr.f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(),
-                                             pr.mv[i].c.data(), load4(correct.invMass + i), fz, dt, correct.h, h2,
-                                             pr.ref[i].c.data(), sq);
-        correctPredict4<A, kAnyFrozen>(pr.torque[i].c.data(), pr.ang[i].c.data(), pr.w[i].c.data(),
-                                       pr.mw[i].c.data(), load4(correct.invInertia + i), fz, dt, correct.h, h2);
-        const V4i beyond = (norms4<D>(sq) > splat(pr.limit2)) & ~fz;
-        far |= (beyond[0] | beyond[1] | beyond[2] | beyond[3]) != 0;
-    };
-    for (; i + 4 <= e; i += 4) {
-        const std::uint8_t* fl = pr.flags + i;
-        std::uint32_t fl4;
-        std::memcpy(&fl4, fl, sizeof fl4);
-        if ((fl4 & 0x01010101u * kFrozen) == 0) {
-            four.template operator()<false>(V4i{0, 0, 0, 0});
-        } else {
-            four.template operator()<true>(V4i{-std::int64_t(fl[0] & kFrozen), -std::int64_t(fl[1] & kFrozen),
-                                               -std::int64_t(fl[2] & kFrozen), -std::int64_t(fl[3] & kFrozen)});
+    // Four particles at a time, with (kAnyFrozen) or without the frozen ones blended back, with (kAng) or without
+    // orientations.
+    auto fours = [&]<bool kAng>() {
+        auto four = [&]<bool kAnyFrozen>(V4i fz) {
+            V4 sq[D];
+            correctPredict4<D, kAnyFrozen, true>(pr.f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(),
+                                                 pr.mv[i].c.data(), load4(correct.invMass + i), fz, dt, correct.h,
+                                                 h2, pr.ref[i].c.data(), sq);
+            correctPredict4<A, kAnyFrozen, false, kAng>(pr.torque[i].c.data(), kAng ? pr.ang[i].c.data() : nullptr,
+                                                        pr.w[i].c.data(), pr.mw[i].c.data(),
+                                                        load4(correct.invInertia + i), fz, dt, correct.h, h2);
+            const V4i beyond = (norms4<D>(sq) > splat(pr.limit2)) & ~fz;
+            far |= (beyond[0] | beyond[1] | beyond[2] | beyond[3]) != 0;
+        };
+        for (; i + 4 <= e; i += 4) {
+            const std::uint8_t* fl = pr.flags + i;
+            std::uint32_t fl4;
+            std::memcpy(&fl4, fl, sizeof fl4);
+            if ((fl4 & 0x01010101u * kFrozen) == 0) {
+                four.template operator()<false>(V4i{0, 0, 0, 0});
+            } else {
+                four.template operator()<true>(V4i{-std::int64_t(fl[0] & kFrozen), -std::int64_t(fl[1] & kFrozen),
+                                                   -std::int64_t(fl[2] & kFrozen), -std::int64_t(fl[3] & kFrozen)});
+            }
         }
-    }
+    };
+    if (pr.ang) fours.template operator()<true>();
+    else fours.template operator()<false>();
     for (; i < e; ++i) {
         correct(i, pr.f[i], pr.torque[i]);
         far |= pr(i);
@@ -273,6 +284,7 @@ bool Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D
     m.v.resize(n);
     m.w.resize(n);
     bool moved = false;
+    const bool angles = !p.angle.empty();
 #pragma omp parallel for schedule(static) reduction(|| : moved) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
         if (p.flags[i] & kFrozen) {
@@ -281,7 +293,8 @@ bool Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D
             continue;
         }
         gearPredict(p.x[i], p.v[i], y_[0][i], y_[1][i], y_[2][i], y_[3][i], dt, m.v[i]);
-        gearPredict(p.angle[i], p.w[i], r_[0][i], r_[1][i], r_[2][i], r_[3][i], dt, m.w[i]);
+        Ang<D> turned{};  // the orientation when kept, else a stand-in the predictor moves
+        gearPredict(angles ? p.angle[i] : turned, p.w[i], r_[0][i], r_[1][i], r_[2][i], r_[3][i], dt, m.w[i]);
         moved |= norm2(p.x[i] - ref[i]) > limit2;
     }
     return moved;
@@ -290,11 +303,14 @@ bool Gear5<D>::predict(Particles<D>& p, double dt, StepMotion<D>& m, const Vec<D
 template <int D>
 void Gear5<D>::correct(Particles<D>& p, double dt, const StepMotion<D>&) {
     const std::size_t n = p.tdmCount();
+    const bool angles = !p.angle.empty();
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t i = 0; i < n; ++i) {
         if (p.flags[i] & kFrozen) continue;
         gearCorrect(p.x[i], p.v[i], y_[0][i], y_[1][i], y_[2][i], y_[3][i], p.f[i] * p.invMass[i], dt);
-        gearCorrect(p.angle[i], p.w[i], r_[0][i], r_[1][i], r_[2][i], r_[3][i], p.torque[i] * p.invInertia[i], dt);
+        Ang<D> turned{};
+        gearCorrect(angles ? p.angle[i] : turned, p.w[i], r_[0][i], r_[1][i], r_[2][i], r_[3][i],
+                    p.torque[i] * p.invInertia[i], dt);
     }
 }
 

@@ -78,8 +78,9 @@ public:
                 p.invMass.data(), p.invInertia.data(), p.flags.data(), 0.5 * dt};
     }
 
-    /// The predictor of one particle: position and angle to t + dt, velocities to v + a dt, the mean velocities
-    /// over the step into m; returns whether the particle is now farther than sqrt(limit2) from ref[i].
+    /// The predictor of one particle: position and angle (when kept, else ang is null) to t + dt, velocities to
+    /// v + a dt, the mean velocities over the step into m; returns whether the particle is now farther than
+    /// sqrt(limit2) from ref[i].
     /// predict() runs it over all particles. a(t): the force and torque in the store (of the last force pass).
     struct Predictor {
         Vec<D>* x;
@@ -118,7 +119,7 @@ public:
             mw[i] = w[i] + al * (0.5 * dt);
             x[i] += v[i] * dt + a * h2;
             v[i] += a * dt;
-            ang[i] += w[i] * dt + al * h2;
+            if (ang) ang[i] += w[i] * dt + al * h2;
             w[i] += al * dt;
             return norm2(x[i] - ref[i]) > limit2;
         }
