@@ -3,7 +3,7 @@
 //
 //   haet_settle_steps hexagons|disks STEPS [THREADS]
 //
-// Prints the contacts of the last step and a checksum of the positions and angles.
+// Prints the contacts of the last step and a checksum of the positions and the angles (disks: spins).
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
     for (int k = 0; k < steps; ++k) eng.step();
     double sum = 0;
     for (std::size_t i = 0; i < w.particles.size(); ++i)
-        sum += w.particles.x[i][0] * double(1 + i % 7) + w.particles.angle[i][0];
+        sum += w.particles.x[i][0] * double(1 + i % 7) + (polygons ? w.particles.angle[i][0] : w.particles.w[i][0]);
     std::printf("%s, %d steps: %zu contacts, checksum %.17g\n", argv[1], steps, eng.forceStats().contacts, sum);
     return 0;
 }

@@ -129,27 +129,40 @@ struct NoTangential {
     static V eval(const C&, S, S, S, const V&, const V&, const V&, V&, double) {
         return V::zero();
     }
+    template <class C, class S, class V>
+    static V eval(const C&, S, S, S, const V&, const V&, S, const V&, const V&, V&, double) {
+        return V::zero();
+    }
 };
 
 /// Cundall-Strack tangential spring with Coulomb limit and history (B.4).
 /// xi: the spring elongation [m], kept per contact; gt: tangential relative velocity of the contact points
 /// (for the damping); gStep: the relative velocity of the contact points averaged over the last step, normal part
-/// included (the law removes it), so that xi grows by the true relative displacement.
+/// included (the law removes it), so that xi grows by the true relative displacement. n: the unit normal, d/|d|
+/// for a pair with separation d (dist2 = |d|^2); a wall's normal is its own d (dist2 = 1).
 struct SpringTangential {
     static constexpr bool kHasHistory = true;
     template <class C, class S, class V>  // V: Vec<D> or Wide3 (core/wide3.hpp) with S = double; LaneVec<D>, Lanes
     [[gnu::always_inline]] static inline V eval(const C& c, S fn, S kNormal, S meff, const V& n, const V& gt,
                                                 const V& gStep, V& xi, double dt) {
+        return eval(c, fn, kNormal, meff, n, n, S(1.0), gt, gStep, xi, dt);
+    }
+    template <class C, class S, class V>
+    [[gnu::always_inline]] static inline V eval(const C& c, S fn, S kNormal, S meff, const V& n, const V& d, S dist2,
+                                                const V& gt, const V& gStep, V& xi, double dt) {
         // The contact plane turns with the pair: xi is brought into it keeping its length (Luding 2008), then
         // grows by the step's displacement. Both go through one projection P(v) = v - n (n . v), which is linear:
-        // P(s xi) + P(g dt) = P(s xi + g dt); and |P(xi)|^2 = |xi|^2 - (n . xi)^2 for a unit n.
+        // P(s xi) + P(g dt) = P(s xi + g dt); and |P(xi)|^2 = |xi|^2 - (n . xi)^2 for a unit n. The length kept
+        // is taken from d, not n: |d|^2 |P(xi)|^2 = |xi|^2 |d|^2 - (d . xi)^2, so that its division and square
+        // root need not wait for the ones that make n.
         const S len2 = norm2(xi);
         S scale = 1;
         if (anyOf(len2 > 0)) {
-            const S along = dot(n, xi);
-            const S l2new = len2 - along * along;
+            const S along = dot(d, xi);
+            const S a2 = len2 * dist2;
+            const S l2new = a2 - along * along;
             // A spring along n has no direction left: 0.
-            scale = select(len2 > 0, select(l2new > 0, sqrtOf(len2 / l2new), S(0.0)), scale);
+            scale = select(len2 > 0, select(l2new > 0, sqrtOf(a2 / l2new), S(0.0)), scale);
         }
         const V grown = xi * scale + gStep * dt;
         xi = grown - n * dot(n, grown);

@@ -223,7 +223,7 @@ template <class Normal, class Tangential, class C, class S, class V, class A>
         // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
         const V gt = dv - nrm * gn - cross(m.wr, nrm);
         const V gs = m.dsv - cross(m.swr, nrm);
-        const V ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, xi, dt);
+        const V ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, d, dist2, gt, gs, xi, dt);
         f += ft;
         nxft = cross(nrm, ft);
     } else {
