@@ -28,7 +28,10 @@ using testing::replaced;
 using testing::sameBits;
 
 /// threadsXd.toml with 500 fewer particles, and 500 of a second material (other friction and restitution, other sizes).
-Scenario twoMaterialGas(const char* name) {
+/// dense (2D): the first 2 500 on a square lattice of touching disks (spacing one diameter) under the hot start, so
+/// that most of them touch a neighbour: blocks with many touching pairs (the 2D law takes eight at a time when a
+/// block has them).
+Scenario twoMaterialGas(const char* name, bool dense = false) {
     const std::filesystem::path file = std::filesystem::path(HAET_SOURCE_DIR) / "tests" / "data" / name;
     std::ifstream in(file);
     std::stringstream ss;
@@ -39,7 +42,11 @@ restitution = 0.6
 friction = 0.9
 
 [contact])");
-    text = replaced(text, "count = 3000", "count = 2500");
+    if (dense)
+        text = replaced(text, "arrangement = \"random\"\ncount = 3000\nradius = [0.0009, 0.0011]",
+                        "arrangement = \"lattice\"\ncount = 2500\nradius = 0.001\nspacing = 0.002");
+    else
+        text = replaced(text, "count = 3000", "count = 2500");
     text += R"(
 [[insert]]
 arrangement = "random"
@@ -54,7 +61,7 @@ temperature = 0.1
 /// oneLaw: every material pair gets the first pair's coefficients, so the lanes take the table's first entry for
 /// every contact (uniformForceLaw) while the one-by-one loop still looks each pair's entry up.
 template <int D, class Normal>
-void expectLanesMatchOneByOne(const Scenario& sc, int threads, bool oneLaw = false) {
+void expectLanesMatchOneByOne(const Scenario& sc, int threads, bool oneLaw = false, std::size_t minContacts = 40) {
     World<D> w = buildWorld<D>(sc);
     ASSERT_EQ(w.contact.nMaterials, 2);
     TdmEngine<D> eng(w, tdmSettings<D>(sc, w));
@@ -89,7 +96,7 @@ void expectLanesMatchOneByOne(const Scenario& sc, int threads, bool oneLaw = fal
     const ForceStats a = run(std::true_type{}, pa, la, wa);
     const ForceStats b = run(std::false_type{}, pb, lb, wb);
     omp_set_num_threads(before);
-    EXPECT_GT(a.contacts, 40u) << "few contacts: the test would prove little";
+    EXPECT_GT(a.contacts, minContacts) << "few contacts: the test would prove little";
     EXPECT_EQ(a.contacts, b.contacts);
     EXPECT_EQ(std::memcmp(&a.virial, &b.virial, sizeof(double)), 0) << a.virial << " " << b.virial;
     EXPECT_EQ(std::memcmp(&a.maxOverlapRatio, &b.maxOverlapRatio, sizeof(double)), 0);
@@ -102,7 +109,7 @@ void expectLanesMatchOneByOne(const Scenario& sc, int threads, bool oneLaw = fal
     // The touching pairs carry springs (their law ran, not only the contact test).
     std::size_t springs = 0;
     for (const Vec<D>& h : la.history) springs += norm2(h) > 0;
-    EXPECT_GT(springs, 40u);
+    EXPECT_GT(springs, minContacts);
 }
 
 TEST(ForceLanes, LinearSameBitsAsOneByOne3D) {
@@ -115,6 +122,12 @@ TEST(ForceLanes, LinearSameBitsAsOneByOne2D) {
     const Scenario sc = twoMaterialGas("threads2d.toml");
     expectLanesMatchOneByOne<2, LinearNormal>(sc, 1);
     expectLanesMatchOneByOne<2, LinearNormal>(sc, 2);
+}
+
+TEST(ForceLanes, DensePackingSameBitsAsOneByOne2D) {
+    const Scenario sc = twoMaterialGas("threads2d.toml", true);
+    expectLanesMatchOneByOne<2, LinearNormal>(sc, 1, false, 1500);
+    expectLanesMatchOneByOne<2, HertzViscoNormal>(sc, 2, false, 1500);
 }
 
 TEST(ForceLanes, HertzSameBitsAsOneByOne) {

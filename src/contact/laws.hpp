@@ -74,6 +74,17 @@ struct LanePairCoeffs {
     }
 };
 
+/// Eight lanes' coefficients: two groups of four (Lanes2).
+struct LanePairCoeffs2 {
+    Lanes2 knConst, knPerMeff, gnPerMeff, hertzK, dissipationTime, tsujiAlpha, ktRatio, ktConst, gtPerMeff, mu;
+
+    LanePairCoeffs2(const LanePairCoeffs& a, const LanePairCoeffs& b)
+        : knConst(a.knConst, b.knConst), knPerMeff(a.knPerMeff, b.knPerMeff), gnPerMeff(a.gnPerMeff, b.gnPerMeff),
+          hertzK(a.hertzK, b.hertzK), dissipationTime(a.dissipationTime, b.dissipationTime),
+          tsujiAlpha(a.tsujiAlpha, b.tsujiAlpha), ktRatio(a.ktRatio, b.ktRatio), ktConst(a.ktConst, b.ktConst),
+          gtPerMeff(a.gtPerMeff, b.gtPerMeff), mu(a.mu, b.mu) {}
+};
+
 // The laws below are written once for one contact (S = double, C = PairCoeffs, vectors Vec<D> or Wide3) and for
 // four in lanes (S = Lanes, C = LanePairCoeffs, vectors LaneVec<D>): core/lanes.hpp. A branch is a select() of
 // the values both sides give, and the work of a side is skipped when no lane needs it (anyOf).

@@ -9,7 +9,8 @@
 // Vec<N> (or Wide3) or LaneVec<N>, and it uses the helpers below that have a version for each: sqrtOf, select,
 // anyOf, minOf.
 //
-// With AVX a Lanes is one register; without it GCC splits the same code into pairs of SSE operations.
+// With AVX a Lanes is one register; without it GCC splits the same code into pairs of SSE operations. Lanes2 holds
+// two groups of four and runs each operation on both, one after the other (the 2D force loop's eight contacts).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -87,19 +88,58 @@ inline Lanes minOf(Lanes a, Lanes b) { return select(b < a, b, a); }
 inline double maxOf(double a, double b) { return std::max(a, b); }
 inline Lanes maxOf(Lanes a, Lanes b) { return select(a < b, b, a); }
 
-/// N-vectors of four contacts: component c of lane l is c[c][l]. The operations are those of Vec<N>, in the
-/// same order.
-template <int N>
+/// Two groups of four contacts evaluated together: each operation on the first four, then the same on the
+/// other four, so that the two groups' long chains (square roots, divisions) are in flight at the same time.
+/// Lane by lane the arithmetic is that of Lanes.
+struct LaneMask2 {
+    LaneMask lo, hi;
+    friend LaneMask2 operator&(LaneMask2 a, LaneMask2 b) { return {a.lo & b.lo, a.hi & b.hi}; }
+    friend LaneMask2 operator|(LaneMask2 a, LaneMask2 b) { return {a.lo | b.lo, a.hi | b.hi}; }
+};
+struct Lanes2 {
+    Lanes lo, hi;
+
+    Lanes2() = default;
+    Lanes2(double s) : lo(s), hi(s) {}  // NOLINT: a constant of the law, the same in every lane
+    Lanes2(Lanes a, Lanes b) : lo(a), hi(b) {}
+
+    Lanes2& operator+=(Lanes2 o) { lo += o.lo; hi += o.hi; return *this; }
+    Lanes2& operator-=(Lanes2 o) { lo -= o.lo; hi -= o.hi; return *this; }
+    Lanes2& operator*=(Lanes2 o) { lo *= o.lo; hi *= o.hi; return *this; }
+    friend Lanes2 operator+(Lanes2 a, Lanes2 b) { return {a.lo + b.lo, a.hi + b.hi}; }
+    friend Lanes2 operator-(Lanes2 a, Lanes2 b) { return {a.lo - b.lo, a.hi - b.hi}; }
+    friend Lanes2 operator*(Lanes2 a, Lanes2 b) { return {a.lo * b.lo, a.hi * b.hi}; }
+    friend Lanes2 operator/(Lanes2 a, Lanes2 b) { return {a.lo / b.lo, a.hi / b.hi}; }
+    friend Lanes2 operator-(Lanes2 a) { return {-a.lo, -a.hi}; }
+    friend LaneMask2 operator<(Lanes2 a, Lanes2 b) { return {a.lo < b.lo, a.hi < b.hi}; }
+    friend LaneMask2 operator>(Lanes2 a, Lanes2 b) { return {a.lo > b.lo, a.hi > b.hi}; }
+    double operator[](int l) const { return l < 4 ? lo[l] : hi[l - 4]; }
+};
+inline Lanes2 sqrtOf(Lanes2 x) { return {sqrtOf(x.lo), sqrtOf(x.hi)}; }
+inline Lanes2 select(LaneMask2 m, Lanes2 a, Lanes2 b) { return {select(m.lo, a.lo, b.lo), select(m.hi, a.hi, b.hi)}; }
+inline bool anyOf(LaneMask2 m) {
+#ifdef __AVX__
+    return _mm256_movemask_pd(reinterpret_cast<__m256d>(m.lo.m | m.hi.m)) != 0;
+#else
+    return anyOf(m.lo) || anyOf(m.hi);
+#endif
+}
+inline Lanes2 minOf(Lanes2 a, Lanes2 b) { return {minOf(a.lo, b.lo), minOf(a.hi, b.hi)}; }
+inline Lanes2 maxOf(Lanes2 a, Lanes2 b) { return {maxOf(a.lo, b.lo), maxOf(a.hi, b.hi)}; }
+
+/// N-vectors of four contacts (L = Lanes; or eight, L = Lanes2): component c of lane l is c[c][l]. The operations
+/// are those of Vec<N>, in the same order.
+template <int N, class L = Lanes>
 struct LaneVec {
-    std::array<Lanes, N> c;
+    std::array<L, N> c;
 
     static LaneVec zero() {
         LaneVec r;
-        for (int k = 0; k < N; ++k) r.c[k] = Lanes(0.0);
+        for (int k = 0; k < N; ++k) r.c[k] = L(0.0);
         return r;
     }
-    Lanes& operator[](int k) { return c[k]; }
-    Lanes operator[](int k) const { return c[k]; }
+    L& operator[](int k) { return c[k]; }
+    L operator[](int k) const { return c[k]; }
     LaneVec& operator+=(const LaneVec& o) {
         for (int k = 0; k < N; ++k) c[k] += o.c[k];
         return *this;
@@ -108,13 +148,13 @@ struct LaneVec {
         for (int k = 0; k < N; ++k) c[k] -= o.c[k];
         return *this;
     }
-    LaneVec& operator*=(Lanes s) {
+    LaneVec& operator*=(L s) {
         for (int k = 0; k < N; ++k) c[k] *= s;
         return *this;
     }
     friend LaneVec operator+(LaneVec a, const LaneVec& b) { return a += b; }
     friend LaneVec operator-(LaneVec a, const LaneVec& b) { return a -= b; }
-    friend LaneVec operator*(LaneVec a, Lanes s) { return a *= s; }
+    friend LaneVec operator*(LaneVec a, L s) { return a *= s; }
     /// Lane l as a Vec<N>.
     Vec<N> lane(int l) const {
         Vec<N> r;
@@ -123,26 +163,44 @@ struct LaneVec {
     }
 };
 
-/// Component k, or zeros past the last.
+/// Eight contacts' vectors from two groups of four.
 template <int N>
-inline Lanes laneOr0(const LaneVec<N>& a, int k) { return k < N ? a.c[k] : Lanes(0.0); }
+inline LaneVec<N, Lanes2> joinLanes(const LaneVec<N>& a, const LaneVec<N>& b) {
+    LaneVec<N, Lanes2> r;
+    for (int k = 0; k < N; ++k) r.c[k] = Lanes2(a.c[k], b.c[k]);
+    return r;
+}
+/// Group g (0: the first four, 1: the other four) of eight contacts' vectors.
+template <int N>
+inline LaneVec<N> halfOf(const LaneVec<N, Lanes2>& a, int g) {
+    LaneVec<N> r;
+    for (int k = 0; k < N; ++k) r.c[k] = g == 0 ? a.c[k].lo : a.c[k].hi;
+    return r;
+}
 
-template <int N>
-inline Lanes dot(const LaneVec<N>& a, const LaneVec<N>& b) {
-    Lanes s = a[0] * b[0];
+/// Component k, or zeros past the last.
+template <int N, class L>
+inline L laneOr0(const LaneVec<N, L>& a, int k) { return k < N ? a.c[k] : L(0.0); }
+
+template <int N, class L>
+inline L dot(const LaneVec<N, L>& a, const LaneVec<N, L>& b) {
+    L s = a[0] * b[0];
     for (int k = 1; k < N; ++k) s += a[k] * b[k];
     return s;
 }
-template <int N>
-inline Lanes norm2(const LaneVec<N>& a) { return dot(a, a); }
-inline LaneVec<2> cross(const LaneVec<1>& w, const LaneVec<2>& r) { return {{-w[0] * r[1], w[0] * r[0]}}; }
-inline LaneVec<3> cross(const LaneVec<3>& a, const LaneVec<3>& b) {
+template <int N, class L>
+inline L norm2(const LaneVec<N, L>& a) { return dot(a, a); }
+template <class L>
+inline LaneVec<2, L> cross(const LaneVec<1, L>& w, const LaneVec<2, L>& r) { return {{-w[0] * r[1], w[0] * r[0]}}; }
+template <class L>
+inline LaneVec<3, L> cross(const LaneVec<3, L>& a, const LaneVec<3, L>& b) {
     return {{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
 }
-inline LaneVec<1> cross(const LaneVec<2>& r, const LaneVec<2>& f) { return {{r[0] * f[1] - r[1] * f[0]}}; }
-template <int N>
-inline LaneVec<N> select(LaneMask m, const LaneVec<N>& a, const LaneVec<N>& b) {
-    LaneVec<N> r;
+template <class L>
+inline LaneVec<1, L> cross(const LaneVec<2, L>& r, const LaneVec<2, L>& f) { return {{r[0] * f[1] - r[1] * f[0]}}; }
+template <int N, class L, class M>
+inline LaneVec<N, L> select(M m, const LaneVec<N, L>& a, const LaneVec<N, L>& b) {
+    LaneVec<N, L> r;
     for (int k = 0; k < N; ++k) r.c[k] = select(m, a.c[k], b.c[k]);
     return r;
 }
