@@ -5,6 +5,7 @@
 #
 # 1. Preparation (once): when bench/data/chute<case>.flowing.data is missing, writes the lattice with
 #    bench/make_chute_data.sh and lets LAMMPS flow it for PREP_STEPS steps (bench/lammps/in.chute<case>.prep).
+# (5. below: both codes timed again in short windows, the fastest of each compared.)
 # 2. LAMMPS times STEPS steps from that state (bench/lammps/in.chute<case>.time), under /usr/bin/time -v.
 # 3. HAET runs bench/chute<case>.toml from the same file with --threads 1 and --threads 2, under /usr/bin/time -v.
 # 4. Idle baselines: both codes run the same input on a data file with 1 particle in the same box, 10 steps.
@@ -13,6 +14,7 @@
 # frozen base; bytes per particle = (peak RSS - idle peak RSS) / particles.
 #
 # Environment: STEPS (5000), PREP_STEPS (80000), HAET_THREADS ("1 2"), HAET_SKIP=1 (LAMMPS half only),
+#              WINDOW_ROUNDS (8; 0: no windows),
 #              HAET_TIMEOUT (s; default 20 x LAMMPS's loop time + 60), LMP (lmp). Exit status: 0 all measured; 1 a half failed (the other is still reported); 2 usage.
 set -euo pipefail
 
@@ -270,6 +272,45 @@ if [ "$haet_ok" = 1 ]; then
     done
 fi
 
+# --- 5. Windows ---------------------------------------------------------------------------------------
+# The machine's speed changes within a minute, so a whole run's time carries whatever else ran meanwhile. Here each
+# code steps the same state in 40 short windows (3D 25 steps, 2D 50; after as many steps to warm up), one code after
+# the other, WINDOW_ROUNDS times (order swapped each round): the fastest window of each is its time when the
+# machine is least disturbed, and their ratio is the steadiest comparison. LAMMPS: in.<name>.time -var windows;
+# HAET: haet_bench TdmChute<2D|3D> (bench/tdm_chute.cpp), one thread.
+WINDOW_ROUNDS=${WINDOW_ROUNDS:-8}
+wsteps=$([ "$case" = 3d ] && echo 25 || echo 50)
+w_l="" w_h=""
+if [ "$WINDOW_ROUNDS" -gt 0 ] && [ -n "$l_ns" ] && [ -x "$build/haet_bench" ]; then
+    wdir=$runs/windows
+    mkdir -p "$wdir"
+    upper=$(echo "$case" | tr d D)
+    lmp_windows() {
+        (cd "$wdir" && "$LMP" -in "$here/lammps/in.$name.time" -var datain "$flowing" -var steps "$wsteps" \
+            -var wsteps "$wsteps" -var windows 40 -var thermo 1000000000 -log log.lammps -screen none) &&
+        awk -v n="$l_n" '/^Loop time of/ { k++; t = $4 / (n * $9) * 1e9; if (k > 1 && (m == "" || t < m)) m = t }
+            END { if (m != "") printf "%.2f\n", m }' "$wdir/log.lammps"
+    }
+    haet_windows() {
+        "$build/haet_bench" --benchmark_filter="TdmChute$upper" --benchmark_format=json 2>/dev/null |
+            python3 -c 'import json, sys; print("%.2f" % json.load(sys.stdin)["benchmarks"][0]["min_ns_per_particle_step"])'
+    }
+    smaller() { awk -v a="$1" -v m="$2" 'BEGIN { print (m == "" || a + 0 < m + 0) ? a : m }'; }
+    log "windows: $WINDOW_ROUNDS rounds of 40 x $wsteps steps, LAMMPS and HAET one after the other ..."
+    for r in $(seq "$WINDOW_ROUNDS"); do
+        if [ $((r % 2)) = 1 ]; then a=$(lmp_windows || true); b=$(haet_windows || true)
+        else b=$(haet_windows || true); a=$(lmp_windows || true); fi
+        log "  round $r: fastest window LAMMPS ${a:-?}, HAET ${b:-?} ns/particle-step"
+        [ -z "$a" ] || w_l=$(smaller "$a" "$w_l")
+        [ -z "$b" ] || w_h=$(smaller "$b" "$w_h")
+    done
+    if [ -n "$w_l" ] && [ -n "$w_h" ]; then
+        echo "fastest of $((40 * WINDOW_ROUNDS)) windows of $wsteps steps, one thread: LAMMPS $w_l, HAET $w_h ns/particle-step: HAET / LAMMPS $(ratio "$w_h" "$w_l")"
+    else
+        log "windows: no result (see $wdir/log.lammps; haet_bench --benchmark_filter=TdmChute$upper)"
+    fi
+fi
+
 load_after=$(cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo NA)
 echo "load average (1 min) before / after: $load_before / $load_after"
 if awk -v a="$load_before" 'BEGIN { exit !(a + 0 >= 1.5) }'; then
@@ -286,15 +327,15 @@ if [ "$haet_ok" = 1 ] && [ -n "$l_ns" ]; then
 fi
 
 # CSV: one row per HAET thread count (a single row with threads NA when HAET did not run).
-header="case,threads,n_particles,steps,lammps_ns_per_particle_step,haet_ns_per_particle_step,ratio_haet_over_lammps,lammps_bytes_per_particle,haet_bytes_per_particle,haet_speedup_over_1_thread,lammps_cpu_ns_per_particle_step,haet_cpu_ns_per_particle_step,date,haet_commit,load_before"
+header="case,threads,n_particles,steps,lammps_ns_per_particle_step,haet_ns_per_particle_step,ratio_haet_over_lammps,lammps_bytes_per_particle,haet_bytes_per_particle,haet_speedup_over_1_thread,lammps_cpu_ns_per_particle_step,haet_cpu_ns_per_particle_step,date,haet_commit,load_before,lammps_fastest_window_ns,haet_fastest_window_ns"
 now=$(date -u +%Y-%m-%dT%H:%M:%SZ)
 rows=()
 if [ "$haet_ok" = 1 ]; then
     for t in $HAET_THREADS; do
-        rows+=("$name,$t,$h_n,$STEPS,$(or_na "$l_ns"),${h_ns[$t]},$(ratio "${h_ns[$t]}" "$l_ns"),$(or_na "$l_bpp"),${h_bpp[$t]},$(ratio "${h_ns[$first]}" "${h_ns[$t]}"),$(or_na "$l_cpu"),${h_cpu[$t]},$now,$haet_commit,$load_before")
+        rows+=("$name,$t,$h_n,$STEPS,$(or_na "$l_ns"),${h_ns[$t]},$(ratio "${h_ns[$t]}" "$l_ns"),$(or_na "$l_bpp"),${h_bpp[$t]},$(ratio "${h_ns[$first]}" "${h_ns[$t]}"),$(or_na "$l_cpu"),${h_cpu[$t]},$now,$haet_commit,$load_before,$(or_na "$w_l"),$(or_na "$w_h")")
     done
 else
-    rows+=("$name,NA,$(or_na "$l_n"),$STEPS,$(or_na "$l_ns"),NA,NA,$(or_na "$l_bpp"),NA,NA,$(or_na "$l_cpu"),NA,$now,$haet_commit,$load_before")
+    rows+=("$name,NA,$(or_na "$l_n"),$STEPS,$(or_na "$l_ns"),NA,NA,$(or_na "$l_bpp"),NA,NA,$(or_na "$l_cpu"),NA,$now,$haet_commit,$load_before,NA,NA")
 fi
 tmp=$csv.tmp.$$
 {
