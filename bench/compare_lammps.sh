@@ -281,7 +281,7 @@ fi
 WINDOW_ROUNDS=${WINDOW_ROUNDS:-8}
 wsteps=$([ "$case" = 3d ] && echo 25 || echo 50)
 w_l="" w_h=""
-if [ "$WINDOW_ROUNDS" -gt 0 ] && [ -n "$l_ns" ] && [ -x "$build/haet_bench" ]; then
+if [ "$WINDOW_ROUNDS" -gt 0 ] && [ "$haet_ok" = 1 ] && [ -n "$l_ns" ] && [ -x "$build/haet_bench" ]; then
     wdir=$runs/windows
     mkdir -p "$wdir"
     upper=$(echo "$case" | tr d D)

@@ -451,7 +451,7 @@ TEST(EdmEngine, TcModelLetsBallSettle) {
     EXPECT_LT(eng.events(), 10.0 / 1e-4 * 2);  // about one hop per 2 tc
 }
 
-// A pure event-driven run drops forces, torques and angles from the store (Particles::dropTdmState): nothing in
+// A pure event-driven run drops forces and torques from the store (Particles::dropTdmState): nothing in
 // the run reads them, so positions, velocities and spins come out bit-identical, and the store is smaller.
 TEST(EdmEngine, SameRunWithoutTdmState) {
     GasSpec g;

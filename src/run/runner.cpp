@@ -230,7 +230,7 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
             return std::make_unique<TdmDriver<D>>(world, ts, note);
         }
         case Method::Edm: {
-            world.particles.dropTdmState();  // forces, torques and angles: nothing reads them in this run
+            world.particles.dropTdmState();  // forces and torques: nothing reads them in this run
             EdmSettings es = edmSettings(sc);
             es.holdState = true;  // positions, velocities and radii only in the engine between synchronisations
             return std::make_unique<EdmDriver<D>>(world, es);

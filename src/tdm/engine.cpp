@@ -11,7 +11,7 @@ namespace haet {
 template <int D>
 TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s) {
     if (!w_.particles.hasTdmState())
-        throw std::invalid_argument("time-driven engine: the particle store has dropped forces and angles");
+        throw std::invalid_argument("time-driven engine: the particle store has dropped forces and torques");
     if constexpr (D == 2)
         if (w_.particles.hasPolygons()) poly_ = std::make_unique<polygon::PolygonScratch>();
     if (s.integrator == IntegratorKind::Gear5) {
