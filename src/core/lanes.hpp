@@ -81,12 +81,12 @@ inline unsigned bitsOf(LaneMask m) {
     return unsigned(m.m[0] != 0) | unsigned(m.m[1] != 0) << 1 | unsigned(m.m[2] != 0) << 2 | unsigned(m.m[3] != 0) << 3;
 #endif
 }
-/// std::min(a, b) = (b < a) ? b : a, lane by lane.
-inline double minOf(double a, double b) { return std::min(a, b); }
-inline Lanes minOf(Lanes a, Lanes b) { return select(b < a, b, a); }
+/// std::min(a, b) = (b < a) ? b : a, lane by lane (double, Lanes, Lanes2).
+template <class S>
+inline S minOf(S a, S b) { return select(b < a, b, a); }
 /// std::max(a, b) = (a < b) ? b : a, lane by lane.
-inline double maxOf(double a, double b) { return std::max(a, b); }
-inline Lanes maxOf(Lanes a, Lanes b) { return select(a < b, b, a); }
+template <class S>
+inline S maxOf(S a, S b) { return select(a < b, b, a); }
 
 /// Two groups of four contacts evaluated together: each operation on the first four, then the same on the
 /// other four, so that the two groups' long chains (square roots, divisions) are in flight at the same time.
@@ -124,8 +124,6 @@ inline bool anyOf(LaneMask2 m) {
     return anyOf(m.lo) || anyOf(m.hi);
 #endif
 }
-inline Lanes2 minOf(Lanes2 a, Lanes2 b) { return {minOf(a.lo, b.lo), minOf(a.hi, b.hi)}; }
-inline Lanes2 maxOf(Lanes2 a, Lanes2 b) { return {maxOf(a.lo, b.lo), maxOf(a.hi, b.hi)}; }
 
 /// N-vectors of four contacts (L = Lanes; or eight, L = Lanes2): component c of lane l is c[c][l]. The operations
 /// are those of Vec<N>, in the same order.
