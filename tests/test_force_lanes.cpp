@@ -28,9 +28,9 @@ using testing::replaced;
 using testing::sameBits;
 
 /// threadsXd.toml with 500 fewer particles, and 500 of a second material (other friction and restitution, other sizes).
-/// dense (2D): the first 2 500 on a square lattice of touching disks (spacing one diameter) under the hot start, so
-/// that most of them touch a neighbour: blocks with many touching pairs (the 2D law takes eight at a time when a
-/// block has them).
+/// dense: the first 2 500 on a square (cubic) lattice of touching disks (spheres), spacing one diameter, under the
+/// hot start, so that most of them touch a neighbour: blocks with many touching pairs (the 2D law takes eight at
+/// a time when a block has them).
 Scenario twoMaterialGas(const char* name, bool dense = false) {
     const std::filesystem::path file = std::filesystem::path(HAET_SOURCE_DIR) / "tests" / "data" / name;
     std::ifstream in(file);
@@ -128,6 +128,12 @@ TEST(ForceLanes, DensePackingSameBitsAsOneByOne2D) {
     const Scenario sc = twoMaterialGas("threads2d.toml", true);
     expectLanesMatchOneByOne<2, LinearNormal>(sc, 1, false, 1500);
     expectLanesMatchOneByOne<2, HertzViscoNormal>(sc, 2, false, 1500);
+}
+
+TEST(ForceLanes, DensePackingSameBitsAsOneByOne3D) {
+    const Scenario sc = twoMaterialGas("threads3d.toml", true);
+    expectLanesMatchOneByOne<3, LinearNormal>(sc, 1, false, 1000);
+    expectLanesMatchOneByOne<3, HertzTsujiNormal>(sc, 2, false, 1000);
 }
 
 TEST(ForceLanes, HertzSameBitsAsOneByOne) {
