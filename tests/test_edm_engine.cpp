@@ -305,7 +305,7 @@ TEST(EdmEngine, PeriodicWrapRecordsImages) {
     EdmEngine<2> eng(w, EdmSettings{});
     for (int k = 1; k <= 20; ++k) {
         eng.advanceTo(k * 1.0);
-        const Vec<2> unwrapped = w.particles.x[0] + w.particles.image[0];
+        const Vec<2> unwrapped = w.domain.unwrap(w.particles.x[0], w.particles.image[0]);
         EXPECT_NEAR(unwrapped[0], 1 + 3.3 * k, 1e-12);
         EXPECT_NEAR(unwrapped[1], 1 - 1.7 * k, 1e-12);
         EXPECT_GE(w.particles.x[0][0], 0);
@@ -329,7 +329,7 @@ TEST(EdmEngine, ManyWrapsBetweenSynchronisations) {
     const double t = 800;  // 1240 wraps along x, 920 along y
     eng.advanceEvents(t);
     eng.synchronise(t);
-    const Vec<3> unwrapped = w.particles.x[0] + w.particles.image[0];
+    const Vec<3> unwrapped = w.domain.unwrap(w.particles.x[0], w.particles.image[0]);
     EXPECT_NEAR(unwrapped[0], 0.5 + 3.1 * t, 1e-9);
     EXPECT_NEAR(unwrapped[1], 0.5 - 2.3 * t, 1e-9);
     EXPECT_NEAR(unwrapped[2], 0.5 + 0.7 * t, 1e-9);

@@ -160,7 +160,9 @@ void checkBlockStepMatchesTwins(bool polygons = false) {
             EXPECT_TRUE(std::memcmp(&b.v[i], &p.v[i], sizeof(Vec<D>)) == 0) << i;
         } else {
             EXPECT_NE(b.x[i][0], p.x[i][0]) << i;
-            if (polygons) EXPECT_NE(b.angle[i][0], p.angle[i][0]) << i;
+            if (polygons) {
+                EXPECT_NE(b.angle[i][0], p.angle[i][0]) << i;
+            }
         }
     }
 }

@@ -632,7 +632,7 @@ Velocities
     EXPECT_EQ(p.v[1], (Vec<3>{{0.1, 0.2, 0.3}}));
     EXPECT_EQ(p.w[1], (Vec<3>{{1, 2, 3}}));
     EXPECT_EQ(p.v[2], Vec<3>::zero());  // no Velocities line
-    EXPECT_EQ(p.image[1], (Vec<3>{{0.1, 0, -0.25}}));
+    EXPECT_EQ(p.image[1], (std::array<std::int32_t, 3>{1, 0, -1}));  // the file's flags
 
     // A malformed Atoms line is reported at its line.
     const fs::path bad = write("bad.data", replaced(data, "3 5 0.002 1000", "3 5 -0.002 1000"));

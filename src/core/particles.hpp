@@ -51,7 +51,8 @@ struct Particles {
     // cold
     std::vector<double> mass;     ///< [kg] (kept for frozen particles too, for contact effective mass)
     std::vector<std::uint64_t> id;  ///< stable user-visible id (survives reordering)
-    std::vector<Vec<D>> image;    ///< accumulated periodic wraps, for unwrapped positions [m]
+    /// Periodic box crossings per axis, as LAMMPS's image flags: the unwrapped position is Domain::unwrap(x, image).
+    std::vector<std::array<std::int32_t, D>> image;
     // polygons (2D only). Empty while the store holds no polygon, so disk and sphere runs carry nothing extra:
     // a disk or a sphere looks the same however it has turned, so only a polygon's orientation is kept.
     std::vector<std::uint32_t> shape;  ///< index into `shapes`, kNoShape for a disk
@@ -113,7 +114,7 @@ struct Particles {
         material.push_back(mat);
         flags.push_back(flag);
         id.push_back(pid);
-        image.push_back(Vec<D>::zero());
+        image.push_back({});
         if (!shape.empty()) {
             shape.push_back(kNoShape);
             angle.push_back(Ang<D>::zero());

@@ -175,7 +175,7 @@ void EdmEngine<D>::wrapIntoBox(std::size_t i) {
         if (x >= lo && x < lo + L) continue;
         const double sh = std::floor((x - lo) / L);
         x -= sh * L;
-        p.image[i][k] += sh * L;
+        p.image[i][k] += static_cast<std::int32_t>(sh);
     }
 }
 
@@ -284,7 +284,7 @@ void EdmEngine<D>::setWraps(std::uint32_t s, Shift w) {
         // Whole box lengths from the stored position into Particles::image, as syncSlot does; the box-frame
         // position and so the cell and the pending events stay (the stored x is rounded, as at a synchronisation).
         hot_[s].x[k] -= w[k] * boxLen_[k];
-        w_.particles.image[rec_[s].idx][k] += w[k] * boxLen_[k];
+        w_.particles.image[rec_[s].idx][k] += w[k];
         w[k] = 0;
     }
     link_[s].wrap = packWraps(w);
@@ -1356,7 +1356,7 @@ void EdmEngine<D>::storeSlot(std::uint32_t s) {
         if (x >= lo && x < lo + L) continue;
         const double sh = std::floor((x - lo) / L);
         x -= sh * L;
-        p.image[i][k] += sh * L;
+        p.image[i][k] += static_cast<std::int32_t>(sh);
         // The box-frame position x - wrap L is unchanged, so the cell and the pending events stay valid.
         ws[k] -= static_cast<std::int32_t>(sh);
     }

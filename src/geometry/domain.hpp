@@ -1,6 +1,7 @@
 #pragma once
 // Simulation box: bounds, periodic axes, gravity; and plane walls.
 #include <array>
+#include <cstdint>
 
 #include "core/vec.hpp"
 
@@ -22,6 +23,11 @@ struct Domain {
         double v = 1;
         for (int k = 0; k < D; ++k) v *= hi[k] - lo[k];
         return v;
+    }
+    /// The unwrapped position of x after `image[k]` crossings of periodic axis k (Particles::image).
+    Vec<D> unwrap(Vec<D> x, const std::array<std::int32_t, D>& image) const {
+        for (int k = 0; k < D; ++k) x[k] += image[k] * (hi[k] - lo[k]);
+        return x;
     }
     /// Minimum-image displacement along periodic axes.
     Vec<D> minimumImage(Vec<D> d) const {

@@ -588,7 +588,7 @@ std::size_t HaetEngine<D>::unwatchedInGuard() const {
 template <int D>
 double HaetEngine<D>::particleEnergy(std::size_t i) const {
     const Particles<D>& p = w_.particles;
-    double e = -p.mass[i] * dot(w_.domain.gravity, p.x[i] + p.image[i]);
+    double e = -p.mass[i] * dot(w_.domain.gravity, w_.domain.unwrap(p.x[i], p.image[i]));
     if (!p.frozen(i)) e += 0.5 * p.mass[i] * norm2(p.v[i]) + 0.5 * p.inertia(i) * norm2(p.w[i]);
     return e;
 }

@@ -298,7 +298,7 @@ void wrapPositions(Particles<D>& p, const Domain<D>& dom) {
             x -= s * L;
             if (x >= dom.hi[k]) x -= L;  // round-off at the upper edge
             if (x < dom.lo[k]) x = dom.lo[k];
-            p.image[i][k] += s * L;
+            p.image[i][k] += static_cast<std::int32_t>(s);
         }
     }
 }

@@ -53,7 +53,7 @@ Energies<D> energies(const World<D>& w) {
         s.kinetic += 0.5 * m * v2;
         s.mv2 += m * v2;
         s.rotational += 0.5 * p.inertia(i) * norm2(p.w[i]);
-        s.potential -= m * dot(w.domain.gravity, p.x[i] + p.image[i]);
+        s.potential -= m * dot(w.domain.gravity, w.domain.unwrap(p.x[i], p.image[i]));
     }
     return s;
 }
@@ -558,13 +558,13 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
     TdmEngine<D> eng(world, ts);
     const std::size_t n = world.particles.size();
     const std::size_t pairs = eng.pairs().size();
-    // Memory: particle arrays (x, v, f, image, mean velocity over the step, position at the list build; w, torque,
-    // mean spin, and a polygon's orientation; radius, mass, 1/m, 1/I, id; list offset, material, flags) +
+    // Memory: particle arrays (x, v, f, mean velocity over the step, position at the list build; w, torque,
+    // mean spin, and a polygon's orientation; radius, mass, 1/m, 1/I, id; image flags; list offset, material, flags) +
     // integrator history (Gear's higher derivatives; velocity Verlet keeps none) + pair list (partner, owner,
     // shift, spring).
     const std::size_t gearHistory = 4 * (sizeof(Vec<D>) + sizeof(Ang<D>));
-    const std::size_t perParticle = sizeof(Vec<D>) * 6 + sizeof(Ang<D>) * (world.particles.hasPolygons() ? 4 : 3) +
-                                    8 * 5 + 8 +
+    const std::size_t perParticle = sizeof(Vec<D>) * 5 + sizeof(Ang<D>) * (world.particles.hasPolygons() ? 4 : 3) +
+                                    8 * 5 + 4 * D + 8 +
                                     (ts.integrator == IntegratorKind::Gear5 ? gearHistory : 0);
     const std::size_t perPair = 4 + 4 + 1 + sizeof(Vec<D>);
     const double steps = std::ceil(sc.duration / ts.dt);

@@ -207,7 +207,7 @@ struct NewParticle {
     double density = 0;  ///< [kg/m^3] (2D: [kg/m^2])
     std::uint16_t material = 0;
     std::uint8_t flags = 0;
-    Vec<D> image{};
+    std::array<std::int32_t, D> image{};  ///< periodic box crossings (Particles::image)
     std::vector<Vec<2>> body;  ///< polygon vertices in the body frame [m]; empty for a disk or sphere
     double orientation = 0;    ///< polygon angle [rad]
 
@@ -414,9 +414,7 @@ std::vector<NewParticle<D>> insertFromFile(const Scenario& s, std::size_t k) {
         const bool frozenType =
             std::find(in.frozenTypes.begin(), in.frozenTypes.end(), fp.type) != in.frozenTypes.end();
         p.flags = (in.frozen || fp.frozen || frozenType) ? kFrozen : 0;
-        if (pf.boxLo && pf.boxHi)
-            for (int a = 0; a < D; ++a)
-                p.image[a] = fp.image[std::size_t(a)] * ((*pf.boxHi)[std::size_t(a)] - (*pf.boxLo)[std::size_t(a)]);
+        for (int a = 0; a < D; ++a) p.image[a] = fp.image[std::size_t(a)];
         out.push_back(p);
     }
     return out;
