@@ -43,9 +43,11 @@ void queueBench(benchmark::State& state) {
 
 void tree(benchmark::State& s) { queueBench<haet::EventTree>(s); }
 void heap(benchmark::State& s) { queueBench<haet::EventHeap>(s); }
+void calendar(benchmark::State& s) { queueBench<haet::EventCalendar>(s); }
 
 BENCHMARK(tree)->Name("EdmQueue/tree")->RangeMultiplier(10)->Range(1000, 1000000);
 BENCHMARK(heap)->Name("EdmQueue/heap")->RangeMultiplier(10)->Range(1000, 1000000);
+BENCHMARK(calendar)->Name("EdmQueue/calendar")->RangeMultiplier(10)->Range(1000, 1000000);
 
 }  // namespace
 

@@ -49,6 +49,10 @@ TEST(EdmQueue, TreeMatchesScan) {
     for (std::size_t n : {1u, 2u, 3u, 7u, 64u, 100u, 1000u}) compareWithScan<EventTree>(n, n);
 }
 
+TEST(EdmQueue, CalendarMatchesScan) {
+    for (std::size_t n : {1u, 2u, 3u, 7u, 64u, 100u, 1000u, 5000u}) compareWithScan<EventCalendar>(n, n + 2);
+}
+
 TEST(EdmQueue, HeapMatchesScan) {
     for (std::size_t n : {1u, 2u, 3u, 7u, 64u, 100u, 1000u}) compareWithScan<EventHeap>(n, n + 1);
 }

@@ -363,7 +363,7 @@ private:
     };
     std::vector<Rec> rec_;
     std::vector<double> tLast_;  // per slot: time of the last collision (only with the TC model)
-    EventTree queue_;  // pending event times
+    EventCalendar queue_;  // pending event times
     // cell grid (singly linked lists: a crossing walks the old cell's few members to unlink)
     std::vector<std::uint32_t> head_;
     static constexpr int kNbrCells = D == 3 ? 27 : 9, kSideCells = D == 3 ? 9 : 3;
