@@ -1173,7 +1173,7 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     // through infinitely many collisions.
     const double gAcc = fb ? dot(n, g_) : 0;
     const double uRest = (tc_ > 0 && gAcc < 0) ? -gAcc * tc_ : 0;
-    const int ma = p.material[i], mb = p.material[j];
+    const int ma = materialOf(i), mb = materialOf(j);
     // A smooth pair (beta = -1 whatever the velocities) gets an impulse along n, which leaves the spins alone:
     // its bodies go without rotation, so the spins are neither read nor written.
     const bool smooth = smoothPair(ma, mb);
@@ -1229,7 +1229,8 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     const double gAcc = dot(n, g_);
     const double uRest = (tc_ > 0 && gAcc < 0) ? -gAcc * tc_ : 0;
     const Vec<D> vs = velAt(hot_[s], t);
-    const bool smooth = smoothPair(p.material[i], wl.material);  // as in collidePair
+    const int ma = materialOf(i);
+    const bool smooth = smoothPair(ma, wl.material);  // as in collidePair
     CollisionBody<D> b1{vs, smooth ? Ang<D>::zero() : p.w[i], hot_[s].r, p.invMass[i],
                         smooth ? 0.0 : p.invInertia[i]};
     CollisionBody<D> b2{wl.velocity, Ang<D>::zero(), 0.0, 0.0, 0.0};
@@ -1241,7 +1242,7 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     advance(s, t);
     const bool elastic = tcElastic(s, kNil, t);
     bool hop = false;
-    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(p.material[i], wl.material, elastic), gn < 0, gn, uRest, hop);
+    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(ma, wl.material, elastic), gn < 0, gn, uRest, hop);
     const double before = kineticEnergy(b1);
     applyImpulse(b1, b2, n, P);
     stats_.dissipated += before - kineticEnergy(b1);
