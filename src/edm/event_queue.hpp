@@ -266,12 +266,11 @@ private:
         pool_.clear();
         free_ = kNil;
         inRing_ = 0;
-        double tmin = std::numeric_limits<double>::infinity(), sum = 0;
+        double tmin = std::numeric_limits<double>::infinity();
         std::size_t m = 0;
         for (const double t : time_)
             if (t < std::numeric_limits<double>::infinity()) {
                 tmin = std::min(tmin, t);
-                sum += t;
                 ++m;
             }
         std::size_t buckets = 2;
@@ -280,7 +279,16 @@ private:
         mask_ = buckets - 1;
         cur_ = 0;
         if (m == 0) return;
-        const double span = sum / static_cast<double>(m) - tmin;  // mean time ahead of the earliest
+        // How far ahead the events lie: the median of up to 1024 of them (every k-th finite time), which a few
+        // events far ahead (a particle alone in a large box) do not move as they would move the mean. For
+        // exponentially distributed delays the mean is the median / ln 2.
+        std::vector<double> sample;
+        const std::size_t every = std::max<std::size_t>(1, m / 1024);
+        std::size_t k = 0;
+        for (const double t : time_)
+            if (t < std::numeric_limits<double>::infinity() && k++ % every == 0) sample.push_back(t - tmin);
+        std::nth_element(sample.begin(), sample.begin() + sample.size() / 2, sample.end());
+        const double span = sample[sample.size() / 2] / 0.6931471805599453;
         origin_ = tmin;
         invWidth_ = span > 0 ? static_cast<double>(m) / (kPerBucket * span) : 1.0;
         for (std::uint32_t i = 0; i < time_.size(); ++i) place(i, time_[i]);
