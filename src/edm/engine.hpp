@@ -163,7 +163,7 @@ public:
         }
         if (interior) {
             const Shift none{};
-            for (const std::int32_t dl : deltaFull_) f(c + static_cast<std::uint32_t>(dl), none);
+            for (int q = 0; q < kNbrCells; ++q) f(c + static_cast<std::uint32_t>(deltaFull_[q]), none);
             return;
         }
         constexpr int m = D == 3 ? 27 : 9;
@@ -372,8 +372,10 @@ private:
     // cell grid (singly linked lists: a crossing walks the old cell's few members to unlink)
     std::vector<std::uint32_t> head_;
     static constexpr int kNbrCells = D == 3 ? 27 : 9, kSideCells = D == 3 ? 9 : 3;
-    std::array<std::int32_t, kNbrCells> deltaFull_{};  // neighbour cell offsets (cells away from the faces)
-    std::array<std::array<std::int32_t, kSideCells>, 2 * D> deltaSide_{};  // new neighbours after a crossing
+    // The offset tables are padded with zeros to whole groups of eight (loadHeads reads eight at a time).
+    static constexpr int kNbrPad = (kNbrCells + 7) / 8 * 8, kSidePad = (kSideCells + 7) / 8 * 8;
+    std::array<std::int32_t, kNbrPad> deltaFull_{};  // neighbour cell offsets (cells away from the faces)
+    std::array<std::array<std::int32_t, kSidePad>, 2 * D> deltaSide_{};  // new neighbours after a crossing
     std::array<int, D> nCell_{};
     std::array<std::uint32_t, D> stride_{};
     Vec<D> cellW_;
