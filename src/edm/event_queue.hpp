@@ -184,7 +184,13 @@ private:
     static constexpr std::uint32_t kNil = 0xFFFFFFFFu;
     // A chunk: the next chunk of the bucket's list (or of the free list), the count, then kChunkSlots slots.
     static constexpr std::uint32_t kChunk = 16, kChunkSlots = kChunk - 2;
-    static bool later(const Entry& a, const Entry& b) { return a.time > b.time || (a.time == b.time && a.slot > b.slot); }
+    // The heap's order, as a function object: the heap algorithms inline it (a function pointer is called).
+    struct Later {
+        bool operator()(const Entry& a, const Entry& b) const {
+            return a.time > b.time || (a.time == b.time && a.slot > b.slot);
+        }
+    };
+    static constexpr Later later{};
     double rel(double t) const { return (t - origin_) * invWidth_; }  // bucket coordinate
 
     // Time t of slot i to the heap (its bucket is the current one or earlier), a bucket of the ring, or the overflow.
