@@ -1292,9 +1292,7 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
 // the event loop
 
 template <int D>
-void EdmEngine<D>::countEvent(double t) {
-    ++events_;
-    if (events_ - winEvents_ < window_) return;
+void EdmEngine<D>::checkRate(double t) {
     const double span = t - winTime_;
     const double perParticle = static_cast<double>(window_) / static_cast<double>(std::max<std::size_t>(1, nMoving_));
     const bool tooFast = maxRate_ > 0 ? perParticle > maxRate_ * span : !(span > 0);

@@ -321,7 +321,11 @@ private:
     void storeSlot(std::uint32_t s);
     void putBackState();
     std::uint32_t zoneOfCell(std::uint32_t c) const;
-    void countEvent(double t);
+    /// Counts an event; at the end of each window of events, checks the event rate (checkRate).
+    void countEvent(double t) {
+        if (++events_ - winEvents_ >= window_) checkRate(t);
+    }
+    [[gnu::noinline]] void checkRate(double t);
     Vec<D> posAt(const Hot& h, double t) const;
     Vec<D> velAt(const Hot& h, double t) const;
     bool frozen(std::uint32_t s) const { return hot_[s].t == kNever; }  // also true for a free slot
