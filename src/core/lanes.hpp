@@ -212,24 +212,45 @@ inline LaneIndex loadIndex(const std::uint32_t* p) {
     return r;
 }
 
-/// base[idx[l]] in lane l.
+/// base[idx[l]] in lane l: four loads put side by side. (The AVX2 gather instructions are slow on AMD Zen 4: with
+/// them, here and below, the 3D chute's step took a third more time; bench/README.md, "Partners prefetched".)
 inline Lanes gather(const double* base, LaneIndex idx) {
-#ifdef __AVX2__
-    // The masked form with a zero source: the plain one leaves GCC warning about its undefined source.
-    const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
-    return Lanes(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), base, reinterpret_cast<__m128i>(idx), all, 8));
+#ifdef __AVX__
+    const __m128d lo = _mm_loadh_pd(_mm_load_sd(base + idx[0]), base + idx[1]);
+    const __m128d hi = _mm_loadh_pd(_mm_load_sd(base + idx[2]), base + idx[3]);
+    return Lanes(_mm256_insertf128_pd(_mm256_castpd128_pd256(lo), hi, 1));
 #else
     return Lanes(Lanes::Values{base[idx[0]], base[idx[1]], base[idx[2]], base[idx[3]]});
 #endif
 }
 
-/// a[idx[l]] in lane l.
+/// a[idx[l]] in lane l: the four rows loaded whole and transposed.
 template <int N>
 inline LaneVec<N> gather(const Vec<N>* a, LaneIndex idx) {
-    const double* base = a[0].c.data();
-    const LaneIndex at = idx * N;
     LaneVec<N> r;
-    for (int k = 0; k < N; ++k) r.c[k] = gather(base + k, at);
+#ifdef __AVX__
+    if constexpr (N == 3) {
+        // A masked load reads the three doubles only (never past the array's end).
+        const __m256i m = _mm256_setr_epi64x(-1, -1, -1, 0);
+        const __m256d r0 = _mm256_maskload_pd(a[idx[0]].c.data(), m), r1 = _mm256_maskload_pd(a[idx[1]].c.data(), m);
+        const __m256d r2 = _mm256_maskload_pd(a[idx[2]].c.data(), m), r3 = _mm256_maskload_pd(a[idx[3]].c.data(), m);
+        const __m256d ab0 = _mm256_unpacklo_pd(r0, r1), ab1 = _mm256_unpackhi_pd(r0, r1);
+        const __m256d cd0 = _mm256_unpacklo_pd(r2, r3), cd1 = _mm256_unpackhi_pd(r2, r3);
+        r.c[0] = Lanes(_mm256_permute2f128_pd(ab0, cd0, 0x20));
+        r.c[1] = Lanes(_mm256_permute2f128_pd(ab1, cd1, 0x20));
+        r.c[2] = Lanes(_mm256_permute2f128_pd(ab0, cd0, 0x31));
+        return r;
+    } else if constexpr (N == 2) {
+        const __m256d r02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(a[idx[0]].c.data())),
+                                                 _mm_loadu_pd(a[idx[2]].c.data()), 1);
+        const __m256d r13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(a[idx[1]].c.data())),
+                                                 _mm_loadu_pd(a[idx[3]].c.data()), 1);
+        r.c[0] = Lanes(_mm256_unpacklo_pd(r02, r13));
+        r.c[1] = Lanes(_mm256_unpackhi_pd(r02, r13));
+        return r;
+    }
+#endif
+    for (int k = 0; k < N; ++k) r.c[k] = Lanes(Lanes::Values{a[idx[0]][k], a[idx[1]][k], a[idx[2]][k], a[idx[3]][k]});
     return r;
 }
 

@@ -146,6 +146,7 @@ struct PairInputs {
     const Vec<D>* sv;  ///< mean velocities over the last step (StepMotion)
     const Ang<D>* sw;
     const std::uint32_t* partner;
+    std::uint32_t nPairs;        ///< listed pairs (elements of partner)
     const std::uint32_t* owner;  ///< owner of each pair (PairList::owner, made for the four-wide contact tests)
     const std::uint8_t* shift;
     const Vec<D>* shiftVec;
@@ -163,7 +164,8 @@ PairInputs<D> pairInputs(const Particles<D>& p, PairList<D>& pl, const ContactSe
                          const Ang<D>* sw, double dt) {
     return {p.x.data(),        p.v.data(),      p.w.data(),         p.radius.data(),
             p.invMass.data(),  p.material.data(), sv,               sw,
-            pl.partner.data(), pl.owner.data(), pl.shift.data(),   pl.shiftVec.data(), pl.history.data(),
+            pl.partner.data(), static_cast<std::uint32_t>(pl.partner.size()),
+            pl.owner.data(),   pl.shift.data(), pl.shiftVec.data(), pl.history.data(),
             cs.table.data(),   cs.nMaterials,   uniformForceLaw(cs.table.data(), cs.table.size()),
             !cs.attraction,    dt};
 }
@@ -470,29 +472,6 @@ struct CompactTables {
 };
 inline constexpr CompactTables kCompact{};
 
-/// Rows idx[0..3] of a (D doubles each) as D lanes: lane l of out[c] is a[idx[l]][c].
-template <int D>
-[[gnu::always_inline]] inline void loadTransposed(const Vec<D>* a, const std::uint32_t* idx, __m256d* out) {
-    if constexpr (D == 3) {
-        // A masked load reads the three doubles only (never past the array's end).
-        const __m256i m = _mm256_setr_epi64x(-1, -1, -1, 0);
-        const __m256d r0 = _mm256_maskload_pd(a[idx[0]].c.data(), m), r1 = _mm256_maskload_pd(a[idx[1]].c.data(), m);
-        const __m256d r2 = _mm256_maskload_pd(a[idx[2]].c.data(), m), r3 = _mm256_maskload_pd(a[idx[3]].c.data(), m);
-        const __m256d ab0 = _mm256_unpacklo_pd(r0, r1), ab1 = _mm256_unpackhi_pd(r0, r1);
-        const __m256d cd0 = _mm256_unpacklo_pd(r2, r3), cd1 = _mm256_unpackhi_pd(r2, r3);
-        out[0] = _mm256_permute2f128_pd(ab0, cd0, 0x20);
-        out[1] = _mm256_permute2f128_pd(ab1, cd1, 0x20);
-        out[2] = _mm256_permute2f128_pd(ab0, cd0, 0x31);
-    } else {
-        const __m256d r02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(a[idx[0]].c.data())),
-                                                 _mm_loadu_pd(a[idx[2]].c.data()), 1);
-        const __m256d r13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(a[idx[1]].c.data())),
-                                                 _mm_loadu_pd(a[idx[3]].c.data()), 1);
-        out[0] = _mm256_unpacklo_pd(r02, r13);
-        out[1] = _mm256_unpackhi_pd(r02, r13);
-    }
-}
-
 /// Pass (1) over the block's particles [b0, b1) (one thread: no cross pairs), four listed pairs at a time in AVX
 /// lanes, taken in slot order across owners: the four contact tests give a mask; the touching pairs' fields are
 /// compacted by it (a table of lane permutations) and stored at the end of the list, which grows by the mask's
@@ -517,19 +496,34 @@ template <int D, class Tangential>
         last = _mm_max_epu32(last, _mm_cvtsi32_si128(static_cast<int>(j)));
         nl += testPair<D, Tangential>(in, bl, i, kernelVec(in.x[i]), in.radius[i], k, j, nl);
     };
+    // The partners' rows that this pass and the law read, prefetched kAhead pairs ahead: the partners are not in
+    // address order, and on a core with a 1 MB L2 (AMD Zen 4) waiting for them took about a fifth of the step
+    // (bench/README.md, "Partners prefetched").
+    constexpr std::uint32_t kAhead = 16;
     for (; 4 * g + 4 <= n; ++g) {
         const std::uint32_t k = k0 + 4 * g;
         const std::uint32_t* ii = own + 4 * g;
         const std::uint32_t* jj = partner + k;
         const __m128i vi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ii));
         const __m128i vj = _mm_loadu_si128(reinterpret_cast<const __m128i*>(jj));
-        __m256d xi[D], xj[D];
-        loadTransposed<D>(in.x, ii, xi);
-        loadTransposed<D>(in.x, jj, xj);
+        if (k + 4 + kAhead <= in.nPairs)
+            for (int l = 0; l < 4; ++l) {
+                const std::uint32_t j = jj[kAhead + l];
+                __builtin_prefetch(&in.x[j]);
+                __builtin_prefetch(&in.v[j]);
+                __builtin_prefetch(&in.invMass[j]);
+                if constexpr (Tangential::kHasHistory) {
+                    __builtin_prefetch(&in.w[j]);
+                    __builtin_prefetch(&in.sv[j]);
+                    __builtin_prefetch(&in.sw[j]);
+                }
+            }
+        const LaneVec<D> xi = gather(in.x, reinterpret_cast<LaneIndex>(vi));
+        const LaneVec<D> xj = gather(in.x, reinterpret_cast<LaneIndex>(vj));
         const __m256d ri = gather(in.radius, reinterpret_cast<LaneIndex>(vi)).v;
         const __m256d rj = gather(in.radius, reinterpret_cast<LaneIndex>(vj)).v;
         __m256d d[D];
-        for (int c = 0; c < D; ++c) d[c] = _mm256_sub_pd(xi[c], xj[c]);
+        for (int c = 0; c < D; ++c) d[c] = _mm256_sub_pd(xi.c[c].v, xj.c[c].v);
         std::uint32_t sh;
         __builtin_memcpy(&sh, in.shift + k, 4);
         if (sh != kNoShift4) {
