@@ -506,7 +506,7 @@ namespace {
 template <int N>
 [[gnu::always_inline]] inline int loadHeads(const std::uint32_t* hc, const std::int32_t* deltas, std::uint32_t* heads) {
     int nc = 0;
-#if defined(__AVX2__) && defined(__BMI2__) && !defined(HAET_SCALAR_HEADS)
+#if defined(__AVX2__) && defined(__BMI2__)
     for (int g = 0; g < N; g += 8) {
         const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(deltas + g));
         const __m256i h = _mm256_i32gather_epi32(reinterpret_cast<const int*>(hc), idx, 4);

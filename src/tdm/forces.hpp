@@ -646,12 +646,19 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
         transpose4(nb, o[0]->b.c, o[1]->b.c, o[2]->b.c, o[3]->b.c);
     };
     std::uint32_t m = 0;
-    // 2D: eight pairs at a time, two groups of four side by side (Lanes2), then the last four. The law's chain of
+    // Eight pairs at a time, two groups of four side by side (Lanes2), then the last four. The law's chain of
     // square roots and divisions is long and about one group fits the processor's window, so two groups
     // interleaved overlap their chains: the 2D chute's time per particle-step is ~6 % less (the minimum of 40
-    // windows, bench/tdm_chute.cpp, two runs of 6 and 8 alternating rounds: 0.938, 0.944). Not in 3D: two groups'
-    // 3-vectors need more than the 16 registers, and the spills cost more than the overlap gains (1.013).
-    if constexpr (kLanes && D == 2) {
+    // windows, bench/tdm_chute.cpp, two runs of 6 and 8 alternating rounds: 0.938, 0.944). In 3D two groups'
+    // 3-vectors need more than AVX2's 16 registers, so only with AVX-512's 32: 1-2 % less on AMD Zen 4 (8 rounds
+    // twice: fastest windows 52.07 and 52.68 ns against 53.14 and 53.67); on the Intel Xeon measured before,
+    // 1.013.
+#ifdef __AVX512VL__
+    constexpr bool kEight = kLanes;
+#else
+    constexpr bool kEight = kLanes && D == 2;
+#endif
+    if constexpr (kEight) {
         for (; m + 8 <= nl; m += 8) {
             Group g0, g1;
             load(m, g0);
