@@ -295,10 +295,9 @@ template <int D, class Normal, class Tangential, class Then>
 [[gnu::always_inline]] inline ParticleTally finishParticle(Particles<D>& p, const PairInputs<D>& in,
                                                           const Wall<D>* walls, std::size_t nw,
                                                           Vec<D>* wallHistory, const ContactSetup& cs,
-                                                          double time, std::size_t i, const Owner<D>& a,
+                                                          double time, std::size_t i, double ri, const KernelVec<D>& xi,
                                                           KernelVec<D> fk, const KernelVec<kAngDim<D>>& nx,
                                                           double worst, std::uint32_t contacts, Then& then) {
-    const double ri = a.radius;
     const KernelVec<kAngDim<D>> tqk = nx * (-ri);
     // A NaN anywhere reaches the force of its particle in the same step.
     bool finite;
@@ -333,11 +332,11 @@ template <int D, class Normal, class Tangential, class Then>
         }
         p.f[i] = f;
         p.torque[i] = tq;
-        finite = allFinite(f + storedVec(a.x));
+        finite = allFinite(f + storedVec(xi));
     } else {
         p.f[i] = storedVec(fk);
         p.torque[i] = storedVec(tqk);
-        finite = allFinite(fk + a.x);
+        finite = allFinite(fk + xi);
     }
     then(i, p.f[i], p.torque[i]);
     return {worst, contacts, finite};
@@ -810,7 +809,6 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
             startUpTo(bl.reach);
             std::uint32_t t = 0;
             for (std::size_t i = b0; i < b1; ++i) {
-                const Owner<D> a(in, i);
                 KernelVec<D> fi = kernelVec(f[i]);
                 KernelVec<kAngDim<D>> nxi = kernelVec(nx[i]);
                 double worst = 0, vir = 0;
@@ -831,7 +829,8 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
                     worst = std::max(worst, x.b.c[3]);
                     ++nc;
                 }
-                const ParticleTally pt = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, a, fi,
+                const ParticleTally pt = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, in.radius[i],
+                                                                               kernelVec(in.x[i]), fi,
                                                                                nxi, worst, nc, then);
                 st.contacts += pt.contacts;
                 if constexpr (kCross) virial[i] = vir;
