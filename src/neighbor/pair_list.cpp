@@ -107,9 +107,20 @@ struct CellNeighbours {
     int cell = -1;  ///< the cell whose neighbours list holds
     int count = 0;
     Entry list[27];
+    int delta[27];  ///< index offsets of the neighbours of a cell away from the grid's faces, in offset order
 
     CellNeighbours(const Grid<D>& grid, const Domain<D>& domain) : g(&grid), dom(&domain), exact(true) {
         for (int k = 0; k < D; ++k) exact = exact && (!domain.periodic[k] || grid.n[k] >= 3);
+        constexpr int m = (D == 2) ? 9 : 27;
+        for (int offset = 0; offset < m; ++offset) {
+            int u = offset, stride = 1;
+            delta[offset] = 0;
+            for (int k = 0; k < D; ++k) {
+                delta[offset] += (u % 3 - 1) * stride;
+                u /= 3;
+                stride *= grid.n[k];
+            }
+        }
     }
 
     /// Makes list[0, count) the neighbours of cell c.
@@ -123,13 +134,21 @@ struct CellNeighbours {
             t /= g->n[k];
         }
         count = 0;
+        constexpr int m = (D == 2) ? 9 : 27;
+        bool interior = exact;
+        for (int k = 0; k < D; ++k) interior = interior && cc[k] >= 1 && cc[k] <= g->n[k] - 2;
+        if (interior) {  // no face crossed: every image shift is zero (code 13 in 3D, 4 in 2D)
+            constexpr std::uint8_t kNone = (D == 2) ? 4 : 13;
+            for (int offset = 0; offset < m; ++offset) list[offset] = {c + delta[offset], kNone};
+            count = m;
+            return;
+        }
         if (!exact) {
             int cells[27];
             const int nc = neighbourCellsOf<D>(*g, *dom, cc, cells);
             for (int q = 0; q < nc; ++q) list[count++] = {cells[q], kAnyShift};
             return;
         }
-        constexpr int m = (D == 2) ? 9 : 27;
         for (int offset = 0; offset < m; ++offset) {
             std::array<int, D> nc;
             int u = offset, code = 0, mul = 1;
