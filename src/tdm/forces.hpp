@@ -290,14 +290,16 @@ inline bool allFinite(const Wide3& v) {
 }
 
 /// Particle i's pair sums are complete (f: force, nx: sum of n x F_t): adds its wall contacts (in wall order),
-/// stores force and torque -a (sum) + wall torques, then runs the caller's per-particle step then(i, f, torque).
+/// stores force and torque -r_i (sum) + wall torques, then runs the caller's per-particle step then(i, f, torque).
 template <int D, class Normal, class Tangential, class Then>
 [[gnu::always_inline]] inline ParticleTally finishParticle(Particles<D>& p, const PairInputs<D>& in,
                                                           const Wall<D>* walls, std::size_t nw,
                                                           Vec<D>* wallHistory, const ContactSetup& cs,
-                                                          double time, std::size_t i, double ri, const KernelVec<D>& xi,
-                                                          KernelVec<D> fk, const KernelVec<kAngDim<D>>& nx,
-                                                          double worst, std::uint32_t contacts, Then& then) {
+                                                          double time, std::size_t i, KernelVec<D> fk,
+                                                          const KernelVec<kAngDim<D>>& nx, double worst,
+                                                          std::uint32_t contacts, Then& then) {
+    const double ri = in.radius[i];
+    const KernelVec<D> xi = kernelVec(in.x[i]);
     const KernelVec<kAngDim<D>> tqk = nx * (-ri);
     // A NaN anywhere reaches the force of its particle in the same step.
     bool finite;
@@ -829,8 +831,7 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
                     worst = std::max(worst, x.b.c[3]);
                     ++nc;
                 }
-                const ParticleTally pt = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, in.radius[i],
-                                                                               kernelVec(in.x[i]), fi,
+                const ParticleTally pt = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, fi,
                                                                                nxi, worst, nc, then);
                 st.contacts += pt.contacts;
                 if constexpr (kCross) virial[i] = vir;
