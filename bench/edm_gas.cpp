@@ -5,10 +5,10 @@
 // Start: simple cubic (square) lattice with Gaussian velocities, then ~3 collisions per particle to equilibrate
 // (not timed). Each iteration advances the gas by about N collisions, in 10 windows. Counters: collisions per
 // second, the fastest window's collisions per second (the speed when the shared machine disturbs least), events
-// per collision (of which cell crossings or shell exits, and stale events), bytes per particle (engine's own arrays, and with the shared particle store), both while events
-// run, set up as a method = "edm" run: without forces and torques, and with the engine holding positions,
-// velocities and radii (EdmSettings::holdState; a synchronisation gives them back to the store for a moment, 56 or
-// 40 bytes per particle more until the next events).
+// per collision (of which cell crossings or shell exits, and stale events), bytes per particle (engine's own arrays,
+// and with the shared particle store), both while events run, set up as a method = "edm" run: without forces and
+// torques, and with the engine holding positions, velocities and radii (EdmSettings::holdState; a synchronisation gives
+// them back to the store for a moment, 56 or 40 bytes per particle more until the next events).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>

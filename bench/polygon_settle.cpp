@@ -13,7 +13,6 @@
 #include <string>
 
 #include "polygon/geometry.hpp"
-
 #include "scenario/loader.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
@@ -64,7 +63,7 @@ material = "grain"
 haet::World<2> packing(const haet::Scenario& sc, bool polygons) {
     haet::World<2> w = haet::buildWorld<2>(sc);  // no [[insert]]: box, walls
     const double h = 0.5 * std::sqrt(3.0) * kA, width = 0.999 * kA;
-    const double R = width / std::sqrt(3.0);     // hexagon circumradius, flat-to-flat = width
+    const double R = width / std::sqrt(3.0);  // hexagon circumradius, flat-to-flat = width
     for (int r = 0; r < kRows; ++r)
         for (int c = 0; c < kCols; ++c) {
             const haet::Vec<2> x{{(c + 0.5 + 0.5 * (r % 2)) * kA, (r + 0.5) * h + 1e-4}};
@@ -102,7 +101,19 @@ void settle(benchmark::State& state, bool polygons) {
 void hexagons(benchmark::State& s) { settle(s, true); }
 void disks(benchmark::State& s) { settle(s, false); }
 
-BENCHMARK(hexagons)->Name("PolygonSettle2D/hexagons")->Arg(1)->Arg(2)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(disks)->Name("PolygonSettle2D/disks")->Arg(1)->Arg(2)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(hexagons)
+    ->Name("PolygonSettle2D/hexagons")
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(disks)
+    ->Name("PolygonSettle2D/disks")
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace

@@ -27,7 +27,8 @@ void chute(benchmark::State& state) {
     const std::string dir = std::string(HAET_SOURCE_DIR) + "/bench/";
     const std::string data = dir + (D == 3 ? "data/chute3d.flowing.data" : "data/chute2d.flowing.data");
     if (!std::filesystem::exists(data)) {
-        state.SkipWithError(("no " + data + ": bench/compare_lammps.sh prepares it (make bench runs it first)").c_str());
+        state.SkipWithError(
+            ("no " + data + ": bench/compare_lammps.sh prepares it (make bench runs it first)").c_str());
         return;
     }
     const haet::Scenario sc = haet::loadScenario(dir + (D == 3 ? "chute3d.toml" : "chute2d.toml"));

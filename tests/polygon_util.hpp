@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "contact/setup.hpp"
-#include "physics_util.hpp"
 #include "core/rng.hpp"
+#include "physics_util.hpp"
 #include "polygon/geometry.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
@@ -34,7 +34,8 @@ inline double collisionEnergyChange(std::uint64_t seed, double dtFactor, Polygon
     const double off = rng.uniform(-1.2, 1.2) * R;
     const double spin = rng.uniform(-60, 60);
     w.particles.addPolygon(Vec<2>{{-1.05 * R, 0}}, Vec<2>{{0.1, 0}}, Ang<2>{{spin}}, rng.uniform(0, 6.3), a, 2.0, 0, 0);
-    w.particles.addPolygon(Vec<2>{{1.05 * R, off}}, Vec<2>{{-0.1, 0}}, Ang<2>::zero(), rng.uniform(0, 6.3), b, 2.0, 0, 1);
+    w.particles.addPolygon(Vec<2>{{1.05 * R, off}}, Vec<2>{{-0.1, 0}}, Ang<2>::zero(), rng.uniform(0, 6.3), b, 2.0, 0,
+                           1);
     w.contact = buildContactSetup(sc, materialStats(w.particles, 1));
     TdmSettings s;
     s.integrator = IntegratorKind::Gear5;
@@ -63,10 +64,10 @@ inline double collisionEnergyChange(std::uint64_t seed, double dtFactor, Polygon
 /// time step) under the normal law `law`, Young's modulus `young` [N/m] (0: the file's), over `steps` steps. The
 /// energy is read at instants without any contact, where it is purely kinetic.
 struct GasEnergy {
-    double drift = 0;         ///< largest |E / E0 - 1| over the contact-free instants
-    int samples = 0;          ///< contact-free instants
-    double collisions = 0;    ///< contact-steps / 10 (a contact lasts about ten steps)
-    double maxOverlap = 0;    ///< largest overlap depth A/|c| over the smaller bounding radius
+    double drift = 0;       ///< largest |E / E0 - 1| over the contact-free instants
+    int samples = 0;        ///< contact-free instants
+    double collisions = 0;  ///< contact-steps / 10 (a contact lasts about ten steps)
+    double maxOverlap = 0;  ///< largest overlap depth A/|c| over the smaller bounding radius
     std::size_t particles = 0;
 };
 

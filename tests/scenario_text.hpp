@@ -1,10 +1,10 @@
 #pragma once
 // Editing scenario text in tests: where a key is, and a variant with one piece replaced.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace haet::testing {
 

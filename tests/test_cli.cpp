@@ -365,8 +365,8 @@ TEST_F(Cli, RunWritesOutputs) {
 // method = "haet": the hybrid's columns in series.csv, the mode field in the snapshots, the zone images, and
 // `haet check` naming the values in force.
 TEST_F(Cli, HybridRunWritesModesZonesAndColumns) {
-    const std::string text = edit("duration = 0.001", "duration = 0.002\nmethod = \"haet\"") +
-                             "\n[haet]\nrelabel_every = 20\n";
+    const std::string text =
+        edit("duration = 0.001", "duration = 0.002\nmethod = \"haet\"") + "\n[haet]\nrelabel_every = 20\n";
     const fs::path f = write("hybrid.toml", text);
     const Result c = haet("check '" + f.string() + "'");
     ASSERT_EQ(c.code, 0) << c.err;
@@ -378,8 +378,8 @@ TEST_F(Cli, HybridRunWritesModesZonesAndColumns) {
     EXPECT_EQ(checkSeries(out / "series.csv"), 21);
     const std::string series = read(out / "series.csv");
     const std::string header = series.substr(0, series.find('\n'));
-    for (const char* col : {"n_tdm", "n_edm", "events", "tdm_steps", "dissipated_tdm", "dissipated_edm",
-                            "energy_unaccounted"})
+    for (const char* col :
+         {"n_tdm", "n_edm", "events", "tdm_steps", "dissipated_tdm", "dissipated_edm", "energy_unaccounted"})
         EXPECT_NE(header.find(col), std::string::npos) << col << " in: " << header;
     EXPECT_EQ(checkPvd(out / "zones.pvd", ".vti"), 5);
     EXPECT_TRUE(fs::exists(out / "zones_000000.vti"));

@@ -15,7 +15,7 @@ constexpr double kPi = 3.14159265358979323846;
 double clippedRestitution(double e) {
     const double lne = std::log(e);
     const double w0sq = kPi * kPi + lne * lne;  // in units of 1/t_c^2
-    const double eta = -lne;                     // eta t_c
+    const double eta = -lne;                    // eta t_c
     const double w = std::sqrt(w0sq - eta * eta);
     const double tstar = (kPi - std::atan2(2 * eta * w, w * w - eta * eta)) / w;
     return std::exp(-eta * tstar);
@@ -28,8 +28,8 @@ struct Collision {
 
 /// Runs a collision of particle 0 with particle 1 (or a floor wall when wall = true) and measures e and beta.
 template <int D>
-Collision<D> collide(double e, IntegratorKind integ, bool wall, double gtOverGn, double mu,
-                     TangentialLaw tang, double phase) {
+Collision<D> collide(double e, IntegratorKind integ, bool wall, double gtOverGn, double mu, TangentialLaw tang,
+                     double phase) {
     // Short contacts keep the pair's rotation during contact negligible (the normal stays fixed).
     const double tc = 1e-5;
     Scenario sc = testing::linearScenario(D, e, tc, mu, tang);

@@ -2,9 +2,8 @@
 // periodic wrapping, moving walls, frozen particles, the TC model and the collapse guard.
 #include <gtest/gtest.h>
 
-#include <cstring>
-
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -270,7 +269,9 @@ void smoothCollisionsKeepSpins(EdmSettings::Tangential rule, double beta0) {
     EXPECT_NEAR(kineticEnergyEdm(w.particles), e0, 1e-12 * e0);
 }
 
-TEST(EdmEngine, SmoothCollisionsKeepSpinsWalton3D) { smoothCollisionsKeepSpins<3>(EdmSettings::Tangential::Walton, 0.4); }
+TEST(EdmEngine, SmoothCollisionsKeepSpinsWalton3D) {
+    smoothCollisionsKeepSpins<3>(EdmSettings::Tangential::Walton, 0.4);
+}
 TEST(EdmEngine, SmoothCollisionsKeepSpinsConstant2D) {
     smoothCollisionsKeepSpins<2>(EdmSettings::Tangential::Constant, -1.0);
 }

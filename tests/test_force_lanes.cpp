@@ -14,12 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "physics_util.hpp"
 #include "scenario/loader.hpp"
+#include "scenario_text.hpp"
 #include "tdm/engine.hpp"
 #include "tdm/forces.hpp"
 #include "world/build.hpp"
-#include "physics_util.hpp"
-#include "scenario_text.hpp"
 
 namespace haet {
 namespace {
@@ -167,8 +167,10 @@ TEST(ForceLanes, NonFiniteStateIsReported) {
     for (int kind = 0; kind < 2; ++kind) {
         auto run = [&](auto lanes) {
             Particles<3> p = w.particles;
-            if (kind == 0) p.v[touching][1] = std::numeric_limits<double>::quiet_NaN();
-            else p.x[last][2] = std::numeric_limits<double>::infinity();
+            if (kind == 0)
+                p.v[touching][1] = std::numeric_limits<double>::quiet_NaN();
+            else
+                p.x[last][2] = std::numeric_limits<double>::infinity();
             PairList<3> pl = pairs;
             std::vector<Vec<3>> wh(p.tdmCount() * w.walls.size(), Vec<3>::zero());
             ForceScratch<3> s;
@@ -178,8 +180,10 @@ TEST(ForceLanes, NonFiniteStateIsReported) {
         };
         const ForceStats a = run(std::true_type{}), b = run(std::false_type{});
         EXPECT_EQ(a.nonFinite, b.nonFinite);
-        if (kind == 0) EXPECT_LE(a.nonFinite, touching);
-        else EXPECT_EQ(a.nonFinite, last);
+        if (kind == 0)
+            EXPECT_LE(a.nonFinite, touching);
+        else
+            EXPECT_EQ(a.nonFinite, last);
     }
 }
 

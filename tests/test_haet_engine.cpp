@@ -111,19 +111,25 @@ std::string mixedScene(int dim) {
     const std::string hi = d3 ? ", 0.02" : "";
     return "name = 'mixed'\ndimension = " + std::to_string(dim) +
            "\nmethod = 'haet'\nduration = 1\nseed = 5\n"
-           "[domain]\nlo = [0.0, 0.0" + z + "]\nhi = [" + L + ", " + L + zl + "]\nperiodic = [true, true" +
-           (d3 ? ", true" : "") +
+           "[domain]\nlo = [0.0, 0.0" +
+           z + "]\nhi = [" + L + ", " + L + zl + "]\nperiodic = [true, true" + (d3 ? ", true" : "") +
            "]\n"
            "[materials.m]\ndensity = 2500\nrestitution = 0.8\nfriction = 0.4\n"
            "[contact]\nnormal = 'linear'\nduration = 1e-4\ntangential = 'spring'\n"
-           "[tdm]\nintegrator = '" + (d3 ? "verlet" : "gear5") + "'\n"  // both integrators' start-up on a mode change
-           "[[insert]]\narrangement = 'lattice'\ncount = " + std::string(d3 ? "729" : "400") +
+           "[tdm]\nintegrator = '" +
+           (d3 ? "verlet" : "gear5") +
+           "'\n"  // both integrators' start-up on a mode change
+           "[[insert]]\narrangement = 'lattice'\ncount = " +
+           std::string(d3 ? "729" : "400") +
            "\nradius = 0.0005\nspacing = 0.00105\nmaterial = 'm'\ntemperature = 0.01\n"
-           "region = { lo = [" + (d3 ? "0.01, 0.01" : "0.02, 0.02") + lo + "], hi = [" +
-           (d3 ? "0.02, 0.02" : "0.04, 0.04") + hi + "] }\n"
-           "[[insert]]\narrangement = 'random'\ncount = " + std::string(d3 ? "300" : "300") +
+           "region = { lo = [" +
+           (d3 ? "0.01, 0.01" : "0.02, 0.02") + lo + "], hi = [" + (d3 ? "0.02, 0.02" : "0.04, 0.04") + hi +
+           "] }\n"
+           "[[insert]]\narrangement = 'random'\ncount = " +
+           std::string(d3 ? "300" : "300") +
            "\nradius = 0.0005\nmaterial = 'm'\ntemperature = 0.04\n"
-           "region = { lo = [0.0, 0.0" + z + "], hi = [" + L + ", " + (d3 ? "0.009" : "0.018") + zl + "] }\n";
+           "region = { lo = [0.0, 0.0" +
+           z + "], hi = [" + L + ", " + (d3 ? "0.009" : "0.018") + zl + "] }\n";
 }
 
 template <int D>
@@ -147,8 +153,8 @@ void modesChangeWithoutLoss(int buffer) {
     for (int k = 0; k < 20; ++k) {
         for (int s = 0; s < 100; ++s) {
             h.step();
-            ASSERT_EQ(h.unwatchedInGuard(), 0u) << "an event-driven particle in a guard cell is not watched, step "
-                                                << h.steps();
+            ASSERT_EQ(h.unwatchedInGuard(), 0u)
+                << "an event-driven particle in a guard cell is not watched, step " << h.steps();
         }
         h.synchronise();
         ASSERT_EQ(w.particles.size(), n);
@@ -210,7 +216,8 @@ TEST(HaetEngine, UniformlyDiluteRunsAsPureEdm) {
     double worst = 0;
     for (std::size_t i = 0; i < b.particles.size(); ++i) {
         const std::size_t j = indexOf(a.particles.id, b.particles.id[i]);
-        worst = std::max(worst, norm(a.particles.x[j] - b.particles.x[i]) + norm(a.particles.v[j] - b.particles.v[i]) * 1e-3);
+        worst = std::max(worst,
+                         norm(a.particles.x[j] - b.particles.x[i]) + norm(a.particles.v[j] - b.particles.v[i]) * 1e-3);
     }
     EXPECT_LT(worst, 1e-9);
     testing::record("collisions", double(h.collisions()));
@@ -230,8 +237,8 @@ TEST(HaetEngine, EventGridEdgeFollowsTheDilutePartsDensity) {
                                  "\nperiodic = " + per +
                                  "\n[materials.m]\ndensity = 2500\nrestitution = 0.9\nfriction = 0.3\n"
                                  "[contact]\nnormal = 'linear'\nduration = 1e-5\n"
-                                 "[[insert]]\narrangement = 'random'\ncount = " + std::to_string(count) +
-                                 "\nradius = 0.0005\nmaterial = 'm'\ntemperature = 1.0\n";
+                                 "[[insert]]\narrangement = 'random'\ncount = " +
+                                 std::to_string(count) + "\nradius = 0.0005\nmaterial = 'm'\ntemperature = 1.0\n";
         const Scenario sc = parseScenario(text, "gas.toml");
         double cell = 0;
         auto run = [&](auto dimTag) {
@@ -266,8 +273,9 @@ void uniformlyDenseRunsAsPureTdm() {
     const std::string text =
         "name = 'dense'\ndimension = " + std::to_string(D) +
         "\nduration = 1\nseed = 4\n"
-        "[domain]\nlo = [0.0, 0.0" + std::string(d3 ? ", 0.0" : "") + "]\nhi = [0.0105, 0.0105" +
-        (d3 ? ", 0.0105" : "") + "]\nperiodic = [true, true" + (d3 ? ", true" : "") +
+        "[domain]\nlo = [0.0, 0.0" +
+        std::string(d3 ? ", 0.0" : "") + "]\nhi = [0.0105, 0.0105" + (d3 ? ", 0.0105" : "") +
+        "]\nperiodic = [true, true" + (d3 ? ", true" : "") +
         "]\n"
         "[materials.m]\ndensity = 2500\nrestitution = 0.7\nfriction = 0.5\n"
         "[contact]\nnormal = 'linear'\nduration = 1e-4\ntangential = 'spring'\n"

@@ -63,13 +63,13 @@ TEST(HaetZones, HysteresisKeepsADenseZoneUntilBelowPhiOff) {
     g.relabel(withFraction(0.42), {});
     EXPECT_FALSE(g.dense(0));  // below phi_on
     g.relabel(withFraction(0.46), {});
-    EXPECT_TRUE(g.dense(0));   // above phi_on
+    EXPECT_TRUE(g.dense(0));  // above phi_on
     g.relabel(withFraction(0.42), {});
-    EXPECT_TRUE(g.dense(0));   // between: stays dense
+    EXPECT_TRUE(g.dense(0));  // between: stays dense
     g.relabel(withFraction(0.39), {});
     EXPECT_FALSE(g.dense(0));  // below phi_off
     g.relabel(withFraction(0.0), {1});
-    EXPECT_TRUE(g.dense(0));   // sticky
+    EXPECT_TRUE(g.dense(0));  // sticky
 }
 
 TEST(HaetZones, PeriodicBufferWraps3D) {
@@ -90,7 +90,7 @@ TEST(HaetZones, PeriodicBufferWraps3D) {
     // Lattice fraction pi/6 = 0.52. Smoothed: the centre zone 0.52, its face neighbours 2/3 of it (0.35, dense),
     // edge neighbours 4/9 of it (0.23, dilute).
     EXPECT_TRUE(g.dense(g.zoneOf(Vec<3>{{0.5, 0.5, 0.5}})));
-    EXPECT_TRUE(g.dense(g.zoneOf(Vec<3>{{4.5, 0.5, 0.5}})));        // face neighbour across the periodic face
+    EXPECT_TRUE(g.dense(g.zoneOf(Vec<3>{{4.5, 0.5, 0.5}})));  // face neighbour across the periodic face
     EXPECT_FALSE(g.dense(g.zoneOf(Vec<3>{{1.5, 1.5, 0.5}})));
     EXPECT_TRUE(g.timeDriven(g.zoneOf(Vec<3>{{1.5, 1.5, 0.5}})));   // buffer
     EXPECT_TRUE(g.timeDriven(g.zoneOf(Vec<3>{{3.5, 4.5, 0.5}})));   // buffer of the wrapped face neighbour

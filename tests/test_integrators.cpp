@@ -7,8 +7,8 @@
 #include <cstring>
 
 #include "core/rng.hpp"
-#include "tdm/integrators.hpp"
 #include "physics_util.hpp"
+#include "tdm/integrators.hpp"
 
 namespace haet {
 namespace {

@@ -1,4 +1,8 @@
 // Output writers: atomic replacement, VTK files read back byte by byte, CSV/JSON text, PNG headers.
+#include <gtest/gtest.h>
+#include <png.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -8,10 +12,6 @@
 #include <limits>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <png.h>
-#include <unistd.h>
 
 #include "io/atomic_file.hpp"
 #include "io/json.hpp"
@@ -29,8 +29,7 @@ class IoTest : public ::testing::Test {
 protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() /
-               (std::string("haet_io_") + info->name() + "_" + std::to_string(::getpid()));
+        dir_ = fs::temp_directory_path() / (std::string("haet_io_") + info->name() + "_" + std::to_string(::getpid()));
         fs::remove_all(dir_);
         fs::create_directories(dir_);
     }
@@ -354,7 +353,8 @@ TEST_F(IoPng, LinePlot) {
     PlotSeries a{"cell list", {1e2, 1e3, 1e4, 1e5}, {1e-5, 1.1e-4, 1.2e-3, 1.3e-2}, 0x1f77b4};
     PlotSeries b{"all pairs", {1e2, 1e3, 1e4}, {2e-5, 2e-3, std::nan("")}, 0xd62728};
     const fs::path file = dir_ / "plot.png";
-    writeLinePlotPng(file, "time per step", "N", "s", {a, b}, {.widthPx = 640, .heightPx = 400, .logX = true, .logY = true});
+    writeLinePlotPng(file, "time per step", "N", "s", {a, b},
+                     {.widthPx = 640, .heightPx = 400, .logX = true, .logY = true});
     const std::string bytes = slurp(file);
     ASSERT_GE(bytes.size(), 24u);
     EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));

@@ -181,8 +181,8 @@ TEST(Neighbor, RemapCountsTheKeptParticlesDrift) {
     PairList<2> list;
     buildPairList(p, dom, s, PairList<2>{}, list);
     const Vec<2> ref0 = p.x[0];
-    p.x[0][0] -= 0.49 * skin;                                  // drifts away, within skin/2
-    p.x[1] = Vec<2>{p.x[0][0] + 2 * r + 1.01 * skin, 0.5};     // joins just beyond the plain reach
+    p.x[0][0] -= 0.49 * skin;                               // drifts away, within skin/2
+    p.x[1] = Vec<2>{p.x[0][0] + 2 * r + 1.01 * skin, 0.5};  // joins just beyond the plain reach
     p.nTdm = 2;
     const std::vector<Vec<2>> ref{ref0, p.x[1]};
     PairList<2> plain = list, drifting = list;

@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "contact/setup.hpp"
+#include "physics_util.hpp"
 #include "scenario/loader.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
-#include "physics_util.hpp"
 #include "world_util.hpp"
 
 namespace haet {

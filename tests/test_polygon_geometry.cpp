@@ -68,7 +68,7 @@ TEST(PolygonGeometry, ParticleStoreTakesMassAndInertiaFromTheVertices) {
     EXPECT_EQ(p.angle[i][0], 0.7);
     EXPECT_EQ(p.shape[0], kNoShape);
     EXPECT_TRUE(isConvexCcw(p.shapes.of(p.shape[i]), 6));
-    EXPECT_NEAR(p.inertia(0), 0.5 * p.mass[0] * 0.01, 1e-15);  // disks keep I = m r^2 / 2
+    EXPECT_NEAR(p.inertia(0), 0.5 * p.mass[0] * 0.01, 1e-15);                   // disks keep I = m r^2 / 2
     p.add(Vec<2>{{0.9, 0.5}}, Vec<2>::zero(), Ang<2>::zero(), 0.1, 2.0, 0, 2);  // a disk after a polygon
     EXPECT_EQ(p.shape.size(), 3u);
     EXPECT_EQ(p.shape[2], kNoShape);
@@ -115,7 +115,8 @@ Moments referenceOverlap(const std::vector<V2>& P, const std::vector<V2>& Q) {
         }
     if (pts.size() < 3) return Moments{};
     // Andrew's monotone chain.
-    std::sort(pts.begin(), pts.end(), [](const V2& a, const V2& b) { return a[0] != b[0] ? a[0] < b[0] : a[1] < b[1]; });
+    std::sort(pts.begin(), pts.end(),
+              [](const V2& a, const V2& b) { return a[0] != b[0] ? a[0] < b[0] : a[1] < b[1]; });
     std::vector<V2> h(2 * pts.size());
     std::size_t k = 0;
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -347,7 +348,7 @@ TEST(PolygonOverlap, CircleOverlapMatchesFinePolygonAndKnownCases) {
 }
 
 TEST(PolygonOverlap, HalfPlaneCutsTheRightPart) {
-    const auto sq = rectangle(1.0, std::sqrt(2.0), 0.0);  // [-1, 1]^2
+    const auto sq = rectangle(1.0, std::sqrt(2.0), 0.0);                          // [-1, 1]^2
     const Overlap o = halfPlaneOverlap(sq.data(), 4, V2{{0, -0.8}}, V2{{0, 1}});  // floor at y = -0.8
     EXPECT_NEAR(o.area, 0.4, 1e-14);
     EXPECT_NEAR(o.centroid[1], -0.9, 1e-14);
@@ -476,11 +477,10 @@ TEST(PolygonContact, NewtonsThirdLawAndTorqueBalance) {
         double worstF = 0, worstT = 0;
         int checked = 0;
         for (int t = 0; t < 400; ++t) {
-            const auto P =
-                moved(randomConvexPolygon(rng, 3 + t % 12, 0.01, 2.0, 0), V2{{0.3, 0.2}}, rng.uniform(0, 6));
-            const auto Q = moved(randomConvexPolygon(rng, 3 + t % 7, 0.012, 2.0, 0),
-                                 V2{{0.3 + rng.uniform(-0.015, 0.015), 0.2 + rng.uniform(-0.015, 0.015)}},
-                                 rng.uniform(0, 6));
+            const auto P = moved(randomConvexPolygon(rng, 3 + t % 12, 0.01, 2.0, 0), V2{{0.3, 0.2}}, rng.uniform(0, 6));
+            const auto Q =
+                moved(randomConvexPolygon(rng, 3 + t % 7, 0.012, 2.0, 0),
+                      V2{{0.3 + rng.uniform(-0.015, 0.015), 0.2 + rng.uniform(-0.015, 0.015)}}, rng.uniform(0, 6));
             const Overlap oij = clipOverlap(P.data(), int(P.size()), Q.data(), int(Q.size()));
             const Overlap oji = clipOverlap(Q.data(), int(Q.size()), P.data(), int(P.size()));
             if (oij.area < 1e-8) continue;
@@ -551,8 +551,8 @@ TEST(PolygonContact, PotentialLawIsTheGradientOfItsEnergy) {
         const ContactForce f = polygonContact(c, o, bi, bj, nullptr, len, false, false, 1e-5, spring);
         const double h = 1e-6;
         const V2 hx{{h, 0}}, hy{{0, h}};
-        const V2 grad{{(energy(hx, 0, 0) - energy(-hx, 0, 0)) / (2 * h),
-                       (energy(hy, 0, 0) - energy(-hy, 0, 0)) / (2 * h)}};
+        const V2 grad{
+            {(energy(hx, 0, 0) - energy(-hx, 0, 0)) / (2 * h), (energy(hy, 0, 0) - energy(-hy, 0, 0)) / (2 * h)}};
         const double dai = (energy(V2::zero(), h, 0) - energy(V2::zero(), -h, 0)) / (2 * h);
         const double daj = (energy(V2::zero(), 0, h) - energy(V2::zero(), 0, -h)) / (2 * h);
         const double scale = norm(f.f) * (1 + norm(xi - xj));

@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "contact/setup.hpp"
-#include "scenario/loader.hpp"
 #include "physics_util.hpp"
-#include "polygon_util.hpp"
 #include "polygon/geometry.hpp"
+#include "polygon_util.hpp"
+#include "scenario/loader.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
 #include "world_util.hpp"
@@ -23,9 +23,9 @@ constexpr double kPi = 3.14159265358979323846;
 using polygon::V2;
 using testing::record;
 
-constexpr double kYoung = 1e5;   // [N/m]
-constexpr double kDensity = 2.0; // [kg/m^2]
-constexpr double kR = 0.005;     // circumradius [m]
+constexpr double kYoung = 1e5;    // [N/m]
+constexpr double kDensity = 2.0;  // [kg/m^2]
+constexpr double kR = 0.005;      // circumradius [m]
 
 /// One polygon standing on the floor y = 0 under gravity tilted by theta (the same physics as a tilted floor).
 /// Starts at the static overlap of a flat contact, so the transient is small.
@@ -231,7 +231,6 @@ TEST(PolygonIncline, BlockSlidesBeyondTheFrictionAngle) {
     }
 }
 
-
 // ------------------------------------------------------------------------------------------------------------
 // Energy: elastic, frictionless collisions with Gear5
 // ------------------------------------------------------------------------------------------------------------
@@ -317,7 +316,6 @@ TEST(PolygonEnergy, HeadOnFlatCollisionConservesEnergy) {
     EXPECT_NEAR(w.particles.v[0][0], -0.2, 1e-3 * 0.2) << "elastic: the velocities swap sign";
     EXPECT_NEAR(testing::kineticEnergy(w.particles) / e0, 1.0, 1e-4);
 }
-
 
 // ------------------------------------------------------------------------------------------------------------
 // Angle of repose: polygons pile up steeper than disks made the same way (long version: tests/validate/)

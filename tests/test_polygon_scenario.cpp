@@ -15,8 +15,8 @@
 #include "polygon/geometry.hpp"
 #include "scenario/insert.hpp"
 #include "scenario/loader.hpp"
-#include "world/build.hpp"
 #include "scenario_text.hpp"
+#include "world/build.hpp"
 
 namespace fs = std::filesystem;
 
@@ -80,7 +80,8 @@ class PolygonScenario : public ::testing::Test {
 protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("haet_polyscn_" + std::string(info->name()) + "_" + std::to_string(getpid()));
+        dir_ =
+            fs::temp_directory_path() / ("haet_polyscn_" + std::string(info->name()) + "_" + std::to_string(getpid()));
         fs::remove_all(dir_);
         fs::create_directories(dir_);
     }

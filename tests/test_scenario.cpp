@@ -1,12 +1,12 @@
 // Scenario loading (TOML -> definition structs), its error messages, particle insertion and the counter-based RNG.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "core/particles.hpp"
 #include "core/rng.hpp"
@@ -631,7 +631,7 @@ Velocities
     EXPECT_EQ(p.w[0], (Vec<3>{{0, 0, 0.5}}));
     EXPECT_EQ(p.v[1], (Vec<3>{{0.1, 0.2, 0.3}}));
     EXPECT_EQ(p.w[1], (Vec<3>{{1, 2, 3}}));
-    EXPECT_EQ(p.v[2], Vec<3>::zero());  // no Velocities line
+    EXPECT_EQ(p.v[2], Vec<3>::zero());                               // no Velocities line
     EXPECT_EQ(p.image[1], (std::array<std::int32_t, 3>{1, 0, -1}));  // the file's flags
 
     // A malformed Atoms line is reported at its line.

@@ -1,4 +1,5 @@
-// The `haet` command line: run and check scenarios, plot CSV tables. Exit codes: 0 ok, 2 bad input, 3 simulation blew up.
+// The `haet` command line: run and check scenarios, plot CSV tables. Exit codes: 0 ok, 2 bad input, 3 simulation blew
+// up.
 #include <malloc.h>
 
 #include <CLI/CLI.hpp>

@@ -18,7 +18,7 @@ struct PairCoeffs {
     double knPerMeff = 0;  ///< [1/s^2]
     double gnPerMeff = 0;  ///< [1/s]
     // Hertz (B.3): F_el = hertzK sqrt(R_eff) delta^{3/2}, hertzK = (4/3) E_eff.
-    double hertzK = 0;     ///< [Pa]
+    double hertzK = 0;           ///< [Pa]
     double dissipationTime = 0;  ///< viscoelastic A* [s]: F_d = A* hertzK sqrt(R_eff delta) delta_dot
     double tsujiAlpha = 0;       ///< Tsuji: F_d = alpha sqrt(2 m_eff k_H) delta^{1/4} delta_dot (B.3 pitfall)
     // Tangential (B.4)
@@ -34,10 +34,10 @@ struct PairCoeffs {
 /// Whether the force law of every pair of the table is the same, bit for bit (the fields LanePairCoeffs reads):
 /// then the force loop takes the first entry for every contact instead of looking up the pair's materials.
 inline bool uniformForceLaw(const PairCoeffs* table, std::size_t n) {
-    constexpr double PairCoeffs::*kFields[] = {&PairCoeffs::knConst, &PairCoeffs::knPerMeff, &PairCoeffs::gnPerMeff,
-                                               &PairCoeffs::hertzK,  &PairCoeffs::dissipationTime,
-                                               &PairCoeffs::tsujiAlpha, &PairCoeffs::ktRatio, &PairCoeffs::ktConst,
-                                               &PairCoeffs::gtPerMeff, &PairCoeffs::mu};
+    constexpr double PairCoeffs::*kFields[] = {
+        &PairCoeffs::knConst,         &PairCoeffs::knPerMeff,  &PairCoeffs::gnPerMeff, &PairCoeffs::hertzK,
+        &PairCoeffs::dissipationTime, &PairCoeffs::tsujiAlpha, &PairCoeffs::ktRatio,   &PairCoeffs::ktConst,
+        &PairCoeffs::gtPerMeff,       &PairCoeffs::mu};
     for (std::size_t k = 1; k < n; ++k)
         for (const auto f : kFields)
             if (std::memcmp(&(table[k].*f), &(table[0].*f), sizeof(double)) != 0) return false;
@@ -50,9 +50,16 @@ struct LanePairCoeffs {
 
     /// Every lane holds c.
     explicit LanePairCoeffs(const PairCoeffs& c)
-        : knConst(c.knConst), knPerMeff(c.knPerMeff), gnPerMeff(c.gnPerMeff), hertzK(c.hertzK),
-          dissipationTime(c.dissipationTime), tsujiAlpha(c.tsujiAlpha), ktRatio(c.ktRatio), ktConst(c.ktConst),
-          gtPerMeff(c.gtPerMeff), mu(c.mu) {}
+        : knConst(c.knConst),
+          knPerMeff(c.knPerMeff),
+          gnPerMeff(c.gnPerMeff),
+          hertzK(c.hertzK),
+          dissipationTime(c.dissipationTime),
+          tsujiAlpha(c.tsujiAlpha),
+          ktRatio(c.ktRatio),
+          ktConst(c.ktConst),
+          gtPerMeff(c.gtPerMeff),
+          mu(c.mu) {}
     /// Lane l holds table[idx[l]].
     LanePairCoeffs(const PairCoeffs* table, LaneIndex idx) {
         static_assert(sizeof(PairCoeffs) % sizeof(double) == 0);
@@ -79,10 +86,16 @@ struct LanePairCoeffs2 {
     Lanes2 knConst, knPerMeff, gnPerMeff, hertzK, dissipationTime, tsujiAlpha, ktRatio, ktConst, gtPerMeff, mu;
 
     LanePairCoeffs2(const LanePairCoeffs& a, const LanePairCoeffs& b)
-        : knConst(a.knConst, b.knConst), knPerMeff(a.knPerMeff, b.knPerMeff), gnPerMeff(a.gnPerMeff, b.gnPerMeff),
-          hertzK(a.hertzK, b.hertzK), dissipationTime(a.dissipationTime, b.dissipationTime),
-          tsujiAlpha(a.tsujiAlpha, b.tsujiAlpha), ktRatio(a.ktRatio, b.ktRatio), ktConst(a.ktConst, b.ktConst),
-          gtPerMeff(a.gtPerMeff, b.gtPerMeff), mu(a.mu, b.mu) {}
+        : knConst(a.knConst, b.knConst),
+          knPerMeff(a.knPerMeff, b.knPerMeff),
+          gnPerMeff(a.gnPerMeff, b.gnPerMeff),
+          hertzK(a.hertzK, b.hertzK),
+          dissipationTime(a.dissipationTime, b.dissipationTime),
+          tsujiAlpha(a.tsujiAlpha, b.tsujiAlpha),
+          ktRatio(a.ktRatio, b.ktRatio),
+          ktConst(a.ktConst, b.ktConst),
+          gtPerMeff(a.gtPerMeff, b.gtPerMeff),
+          mu(a.mu, b.mu) {}
 };
 
 // The laws below are written once for one contact (S = double, C = PairCoeffs, vectors Vec<D> or Wide3) and for

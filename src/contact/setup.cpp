@@ -14,9 +14,12 @@ double normalForce(NormalLaw law, HertzDamping damping, const PairCoeffs& c, dou
     if (law == NormalLaw::Linear) return LinearNormal::eval(c, delta, ddot, meff, reff).fn;
     if (delta <= 0) return 0;
     switch (damping) {
-        case HertzDamping::Tsuji: return HertzTsujiNormal::eval(c, delta, ddot, meff, reff).fn;
-        case HertzDamping::Viscoelastic: return HertzViscoNormal::eval(c, delta, ddot, meff, reff).fn;
-        case HertzDamping::None: break;
+        case HertzDamping::Tsuji:
+            return HertzTsujiNormal::eval(c, delta, ddot, meff, reff).fn;
+        case HertzDamping::Viscoelastic:
+            return HertzViscoNormal::eval(c, delta, ddot, meff, reff).fn;
+        case HertzDamping::None:
+            break;
     }
     return c.hertzK * std::sqrt(reff) * delta * std::sqrt(delta);
 }
@@ -155,21 +158,20 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
                     // Tsuji's alpha(e) fit assumes the contact ends at zero overlap; with the force clipped at
                     // zero the same alpha gives a larger e. Solve for the alpha that gives e under the rule in
                     // force, starting from the fit (the collision is speed-independent for this law).
-                    c.tsujiAlpha = cd.attraction ? tsujiAlpha(e)
-                                                 : solveHertzDamping(
-                                                       c, HertzDamping::Tsuji,
-                                                       [](PairCoeffs& pc, double x) { pc.tsujiAlpha = x; },
-                                                       std::max(tsujiAlpha(e), 1e-3), e, meffRef, reffRef,
-                                                       cd.impactVelocity, cd.attraction);
+                    c.tsujiAlpha =
+                        cd.attraction
+                            ? tsujiAlpha(e)
+                            : solveHertzDamping(
+                                  c, HertzDamping::Tsuji, [](PairCoeffs& pc, double x) { pc.tsujiAlpha = x; },
+                                  std::max(tsujiAlpha(e), 1e-3), e, meffRef, reffRef, cd.impactVelocity, cd.attraction);
                 } else if (cd.hertzDamping == HertzDamping::Viscoelastic) {
                     if (ma.dissipationTime && mb.dissipationTime) {
                         c.dissipationTime = 0.5 * (*ma.dissipationTime + *mb.dissipationTime);
                     } else {
                         // The elastic contact time bounds any sensible A*.
                         const double eEff = 0.75 * c.hertzK;
-                        const double tcRef = 2.868 * std::pow(meffRef * meffRef /
-                                                                  (reffRef * eEff * eEff * cd.impactVelocity),
-                                                              0.2);
+                        const double tcRef =
+                            2.868 * std::pow(meffRef * meffRef / (reffRef * eEff * eEff * cd.impactVelocity), 0.2);
                         c.dissipationTime = solveHertzDamping(
                             c, HertzDamping::Viscoelastic, [](PairCoeffs& pc, double x) { pc.dissipationTime = x; },
                             tcRef, e, meffRef, reffRef, cd.impactVelocity, cd.attraction);
@@ -221,16 +223,18 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
                 tc = std::min(tc, w2 > 0 ? kPi / std::sqrt(w2) : kPi * std::sqrt(meffMin / kn));
             } else {
                 const double eEff = 0.75 * c.hertzK;
-                tc = std::min(tc, 2.868 * std::pow(meffMin * meffMin / (reffMin * eEff * eEff * cd.impactVelocity), 0.2));
+                tc = std::min(tc,
+                              2.868 * std::pow(meffMin * meffMin / (reffMin * eEff * eEff * cd.impactVelocity), 0.2));
             }
         }
     s.contactTime = tc;
     s.diskContactTime = tc;
     if (cd.normal == NormalLaw::Linear)
-        s.contactTimeNote = cd.kn ? "linear law, fixed k_n: t_c = pi/omega of the lightest pair"
-                                  : "linear law: t_c as given";
+        s.contactTimeNote =
+            cd.kn ? "linear law, fixed k_n: t_c = pi/omega of the lightest pair" : "linear law: t_c as given";
     else
-        s.contactTimeNote = "Hertz: t_c = 2.868 (m_eff^2/(R_eff E_eff^2 v))^(1/5) of the smallest pair at impact_velocity";
+        s.contactTimeNote =
+            "Hertz: t_c = 2.868 (m_eff^2/(R_eff E_eff^2 v))^(1/5) of the smallest pair at impact_velocity";
 
     // Polygons: the thesis rule dt = (pi/10) sqrt(m_min/Y) (PHYSICS.md F.3), with the stiffest pair's Y; their
     // contact time is about ten such steps. The rule assumes light damping: the Gear corrector sees the damping

@@ -38,9 +38,18 @@ struct Lanes {
     Lanes(double s) : v{s, s, s, s} {}  // NOLINT: a constant of the law, the same in every lane
     explicit Lanes(Values x) : v(x) {}
 
-    Lanes& operator+=(Lanes o) { v += o.v; return *this; }
-    Lanes& operator-=(Lanes o) { v -= o.v; return *this; }
-    Lanes& operator*=(Lanes o) { v *= o.v; return *this; }
+    Lanes& operator+=(Lanes o) {
+        v += o.v;
+        return *this;
+    }
+    Lanes& operator-=(Lanes o) {
+        v -= o.v;
+        return *this;
+    }
+    Lanes& operator*=(Lanes o) {
+        v *= o.v;
+        return *this;
+    }
     friend Lanes operator+(Lanes a, Lanes b) { return Lanes(a.v + b.v); }
     friend Lanes operator-(Lanes a, Lanes b) { return Lanes(a.v - b.v); }
     friend Lanes operator*(Lanes a, Lanes b) { return Lanes(a.v * b.v); }
@@ -62,7 +71,9 @@ inline Lanes sqrtOf(Lanes x) {
 }
 /// m ? a : b, lane by lane.
 template <class T>
-inline T select(bool m, const T& a, const T& b) { return m ? a : b; }
+inline T select(bool m, const T& a, const T& b) {
+    return m ? a : b;
+}
 inline Lanes select(LaneMask m, Lanes a, Lanes b) { return Lanes(m.m ? a.v : b.v); }
 /// Whether the condition holds in some lane: the law skips work no lane needs.
 inline bool anyOf(bool m) { return m; }
@@ -83,10 +94,14 @@ inline unsigned bitsOf(LaneMask m) {
 }
 /// std::min(a, b) = (b < a) ? b : a, lane by lane (double, Lanes, Lanes2).
 template <class S>
-inline S minOf(S a, S b) { return select(b < a, b, a); }
+inline S minOf(S a, S b) {
+    return select(b < a, b, a);
+}
 /// std::max(a, b) = (a < b) ? b : a, lane by lane.
 template <class S>
-inline S maxOf(S a, S b) { return select(a < b, b, a); }
+inline S maxOf(S a, S b) {
+    return select(a < b, b, a);
+}
 
 /// Two groups of four contacts evaluated together: each operation on the first four, then the same on the
 /// other four, so that the two groups' long chains (square roots, divisions) are in flight at the same time.
@@ -103,9 +118,21 @@ struct Lanes2 {
     Lanes2(double s) : lo(s), hi(s) {}  // NOLINT: a constant of the law, the same in every lane
     Lanes2(Lanes a, Lanes b) : lo(a), hi(b) {}
 
-    Lanes2& operator+=(Lanes2 o) { lo += o.lo; hi += o.hi; return *this; }
-    Lanes2& operator-=(Lanes2 o) { lo -= o.lo; hi -= o.hi; return *this; }
-    Lanes2& operator*=(Lanes2 o) { lo *= o.lo; hi *= o.hi; return *this; }
+    Lanes2& operator+=(Lanes2 o) {
+        lo += o.lo;
+        hi += o.hi;
+        return *this;
+    }
+    Lanes2& operator-=(Lanes2 o) {
+        lo -= o.lo;
+        hi -= o.hi;
+        return *this;
+    }
+    Lanes2& operator*=(Lanes2 o) {
+        lo *= o.lo;
+        hi *= o.hi;
+        return *this;
+    }
     friend Lanes2 operator+(Lanes2 a, Lanes2 b) { return {a.lo + b.lo, a.hi + b.hi}; }
     friend Lanes2 operator-(Lanes2 a, Lanes2 b) { return {a.lo - b.lo, a.hi - b.hi}; }
     friend Lanes2 operator*(Lanes2 a, Lanes2 b) { return {a.lo * b.lo, a.hi * b.hi}; }
@@ -178,7 +205,9 @@ inline LaneVec<N> halfOf(const LaneVec<N, Lanes2>& a, int g) {
 
 /// Component k, or zeros past the last.
 template <int N, class L>
-inline L laneOr0(const LaneVec<N, L>& a, int k) { return k < N ? a.c[k] : L(0.0); }
+inline L laneOr0(const LaneVec<N, L>& a, int k) {
+    return k < N ? a.c[k] : L(0.0);
+}
 
 template <int N, class L>
 inline L dot(const LaneVec<N, L>& a, const LaneVec<N, L>& b) {
@@ -187,15 +216,21 @@ inline L dot(const LaneVec<N, L>& a, const LaneVec<N, L>& b) {
     return s;
 }
 template <int N, class L>
-inline L norm2(const LaneVec<N, L>& a) { return dot(a, a); }
+inline L norm2(const LaneVec<N, L>& a) {
+    return dot(a, a);
+}
 template <class L>
-inline LaneVec<2, L> cross(const LaneVec<1, L>& w, const LaneVec<2, L>& r) { return {{-w[0] * r[1], w[0] * r[0]}}; }
+inline LaneVec<2, L> cross(const LaneVec<1, L>& w, const LaneVec<2, L>& r) {
+    return {{-w[0] * r[1], w[0] * r[0]}};
+}
 template <class L>
 inline LaneVec<3, L> cross(const LaneVec<3, L>& a, const LaneVec<3, L>& b) {
     return {{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
 }
 template <class L>
-inline LaneVec<1, L> cross(const LaneVec<2, L>& r, const LaneVec<2, L>& f) { return {{r[0] * f[1] - r[1] * f[0]}}; }
+inline LaneVec<1, L> cross(const LaneVec<2, L>& r, const LaneVec<2, L>& f) {
+    return {{r[0] * f[1] - r[1] * f[0]}};
+}
 template <int N, class L, class M>
 inline LaneVec<N, L> select(M m, const LaneVec<N, L>& a, const LaneVec<N, L>& b) {
     LaneVec<N, L> r;
@@ -257,8 +292,7 @@ inline LaneVec<N> gather(const Vec<N>* a, LaneIndex idx) {
 /// Rows r0..r3 of four doubles each, transposed: lane l of out[c] is row l's element c.
 inline void transpose4(const double* r0, const double* r1, const double* r2, const double* r3, Lanes out[4]) {
 #ifdef __AVX__
-    const __m256d a = _mm256_load_pd(r0), b = _mm256_load_pd(r1), c = _mm256_load_pd(r2),
-                  d = _mm256_load_pd(r3);
+    const __m256d a = _mm256_load_pd(r0), b = _mm256_load_pd(r1), c = _mm256_load_pd(r2), d = _mm256_load_pd(r3);
     const __m256d ab0 = _mm256_unpacklo_pd(a, b), ab1 = _mm256_unpackhi_pd(a, b);  // a0 b0 a2 b2 | a1 b1 a3 b3
     const __m256d cd0 = _mm256_unpacklo_pd(c, d), cd1 = _mm256_unpackhi_pd(c, d);
     out[0] = Lanes(_mm256_permute2f128_pd(ab0, cd0, 0x20));

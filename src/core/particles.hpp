@@ -38,18 +38,18 @@ struct ShapeTable {
 template <int D>
 struct Particles {
     // hot: read or written every step
-    std::vector<Vec<D>> x;        ///< centre position [m]
-    std::vector<Vec<D>> v;        ///< velocity [m/s]
-    std::vector<Ang<D>> w;        ///< angular velocity [rad/s]
-    std::vector<Vec<D>> f;        ///< total force [N] (empty without hasTdmState())
-    std::vector<Ang<D>> torque;   ///< total torque [N m] (empty without hasTdmState())
-    std::vector<double> radius;   ///< [m]
-    std::vector<double> invMass;  ///< 1/m [1/kg]; 0 for a frozen particle
-    std::vector<double> invInertia;  ///< 1/I [1/(kg m^2)]; 0 for a frozen particle
+    std::vector<Vec<D>> x;                ///< centre position [m]
+    std::vector<Vec<D>> v;                ///< velocity [m/s]
+    std::vector<Ang<D>> w;                ///< angular velocity [rad/s]
+    std::vector<Vec<D>> f;                ///< total force [N] (empty without hasTdmState())
+    std::vector<Ang<D>> torque;           ///< total torque [N m] (empty without hasTdmState())
+    std::vector<double> radius;           ///< [m]
+    std::vector<double> invMass;          ///< 1/m [1/kg]; 0 for a frozen particle
+    std::vector<double> invInertia;       ///< 1/I [1/(kg m^2)]; 0 for a frozen particle
     std::vector<std::uint16_t> material;  ///< index into the material table
     std::vector<std::uint8_t> flags;      ///< ParticleFlag bits
     // cold
-    std::vector<double> mass;     ///< [kg] (kept for frozen particles too, for contact effective mass)
+    std::vector<double> mass;       ///< [kg] (kept for frozen particles too, for contact effective mass)
     std::vector<std::uint64_t> id;  ///< stable user-visible id (survives reordering)
     /// Periodic box crossings per axis, as LAMMPS's image flags: the unwrapped position is Domain::unwrap(x, image).
     std::vector<std::array<std::int32_t, D>> image;
@@ -192,10 +192,25 @@ struct Particles {
     void swapEntries(std::size_t i, std::size_t j) {
         if (i == j) return;
         auto sw = [&](auto& arr) { std::swap(arr[i], arr[j]); };
-        sw(x); sw(v); sw(w); sw(radius); sw(invMass); sw(invInertia); sw(material); sw(flags); sw(mass); sw(id);
+        sw(x);
+        sw(v);
+        sw(w);
+        sw(radius);
+        sw(invMass);
+        sw(invInertia);
+        sw(material);
+        sw(flags);
+        sw(mass);
+        sw(id);
         sw(image);
-        if (tdmState_) { sw(f); sw(torque); }
-        if (!shape.empty()) { sw(shape); sw(angle); }
+        if (tdmState_) {
+            sw(f);
+            sw(torque);
+        }
+        if (!shape.empty()) {
+            sw(shape);
+            sw(angle);
+        }
     }
 
     /// Applies a permutation: new index k holds old particle order[k]. Used for spatial sorting. A shorter order
@@ -206,10 +221,25 @@ struct Particles {
             for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = arr[order[k]];
             arr.swap(tmp);
         };
-        apply(x); apply(v); apply(w); apply(radius); apply(invMass); apply(invInertia); apply(material);
-        apply(flags); apply(mass); apply(id); apply(image);
-        if (tdmState_) { apply(f); apply(torque); }
-        if (!shape.empty()) { apply(shape); apply(angle); }
+        apply(x);
+        apply(v);
+        apply(w);
+        apply(radius);
+        apply(invMass);
+        apply(invInertia);
+        apply(material);
+        apply(flags);
+        apply(mass);
+        apply(id);
+        apply(image);
+        if (tdmState_) {
+            apply(f);
+            apply(torque);
+        }
+        if (!shape.empty()) {
+            apply(shape);
+            apply(angle);
+        }
     }
 
 private:

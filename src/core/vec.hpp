@@ -51,9 +51,13 @@ constexpr double dot(const Vec<N>& a, const Vec<N>& b) {
     return s;
 }
 template <int N>
-constexpr double norm2(const Vec<N>& a) { return dot(a, a); }
+constexpr double norm2(const Vec<N>& a) {
+    return dot(a, a);
+}
 template <int N>
-inline double norm(const Vec<N>& a) { return std::sqrt(norm2(a)); }
+inline double norm(const Vec<N>& a) {
+    return std::sqrt(norm2(a));
+}
 
 /// Number of components of an angular quantity (spin, torque) in D dimensions.
 template <int D>

@@ -29,9 +29,18 @@ struct Wide3 {
     }
     Vec<3> vec() const { return Vec<3>{{l[0], l[1], l[2]}}; }
 
-    Wide3& operator+=(const Wide3& o) { l += o.l; return *this; }
-    Wide3& operator-=(const Wide3& o) { l -= o.l; return *this; }
-    Wide3& operator*=(double s) { l *= s; return *this; }
+    Wide3& operator+=(const Wide3& o) {
+        l += o.l;
+        return *this;
+    }
+    Wide3& operator-=(const Wide3& o) {
+        l -= o.l;
+        return *this;
+    }
+    Wide3& operator*=(double s) {
+        l *= s;
+        return *this;
+    }
     friend Wide3 operator+(Wide3 a, const Wide3& b) { return {a.l + b.l}; }
     friend Wide3 operator-(Wide3 a, const Wide3& b) { return {a.l - b.l}; }
     friend Wide3 operator*(Wide3 a, double s) { return {a.l * s}; }
@@ -67,9 +76,13 @@ struct KernelVecOf<3> {
 template <int N>
 using KernelVec = typename KernelVecOf<N>::type;
 template <int N>
-inline KernelVec<N> kernelVec(const Vec<N>& a) { return KernelVecOf<N>::of(a); }
+inline KernelVec<N> kernelVec(const Vec<N>& a) {
+    return KernelVecOf<N>::of(a);
+}
 template <int N>
-inline Vec<N> storedVec(const Vec<N>& a) { return a; }
+inline Vec<N> storedVec(const Vec<N>& a) {
+    return a;
+}
 inline Vec<3> storedVec(const Wide3& a) { return a.vec(); }
 
 }  // namespace haet

@@ -81,7 +81,8 @@ void EdmEngine<D>::requireKnownMaterial(std::size_t i) const {
 template <int D>
 void EdmEngine<D>::reset() {
     Particles<D>& p = w_.particles;
-    if (!p.hasMotion()) throw std::logic_error("event-driven engine: reset while it holds the state (synchronise first)");
+    if (!p.hasMotion())
+        throw std::logic_error("event-driven engine: reset while it holds the state (synchronise first)");
     const std::size_t n = p.size();
     const std::size_t first = std::min(s_.firstParticle, n);
     if (n >= (1u << kTypeShift)) throw std::invalid_argument("event-driven engine: too many particles");
@@ -207,8 +208,8 @@ void EdmEngine<D>::buildGrid() {
     if (!(edge > 0)) edge = 1;
     // At most max(2^20, 8 N) cells: a huge open box with few particles gets larger cells. Below 2^29 - 1 in any
     // case: Rec::cell has 29 bits and the free slots' cell is the one past the last.
-    const double maxCells = std::min(double((1u << kCellBits) - 2),
-                                     std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size())));
+    const double maxCells =
+        std::min(double((1u << kCellBits) - 2), std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size())));
     for (;;) {
         double total = 1;
         for (int k = 0; k < D; ++k) {
@@ -579,13 +580,12 @@ template <int D>
     const __m256i bases = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(bt.base));
     const __m128i sameWraps = _mm_cmpeq_epi32(wraps, _mm_set1_epi32(static_cast<int>(wsPacked)));
     const __m256i sameBase = _mm256_cmpeq_epi64(bases, _mm256_set1_epi64x(reinterpret_cast<long long>(plainBase)));
-    const bool plain = (_mm_movemask_ps(_mm_castsi128_ps(sameWraps)) &
-                        _mm256_movemask_pd(_mm256_castsi256_pd(sameBase))) == 15;
+    const bool plain =
+        (_mm_movemask_ps(_mm_castsi128_ps(sameWraps)) & _mm256_movemask_pd(_mm256_castsi256_pd(sameBase))) == 15;
 #else
-    const bool plain = ((bt.wrap[0] ^ wsPacked) | (bt.wrap[1] ^ wsPacked) | (bt.wrap[2] ^ wsPacked) |
-                        (bt.wrap[3] ^ wsPacked)) == 0 &&
-                       bt.base[0] == plainBase && bt.base[1] == plainBase && bt.base[2] == plainBase &&
-                       bt.base[3] == plainBase;
+    const bool plain =
+        ((bt.wrap[0] ^ wsPacked) | (bt.wrap[1] ^ wsPacked) | (bt.wrap[2] ^ wsPacked) | (bt.wrap[3] ^ wsPacked)) == 0 &&
+        bt.base[0] == plainBase && bt.base[1] == plainBase && bt.base[2] == plainBase && bt.base[3] == plainBase;
 #endif
     V X[D], Vv[D], T, R;
     if constexpr (D == 3) {
@@ -1262,8 +1262,7 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     const Vec<D> vs = velAt(hot_[s], t);
     const int ma = materialOf(i);
     const bool smooth = smoothPair(ma, wl.material);  // as in collidePair
-    CollisionBody<D> b1{vs, smooth ? Ang<D>::zero() : p.w[i], hot_[s].r, p.invMass[i],
-                        smooth ? 0.0 : p.invInertia[i]};
+    CollisionBody<D> b1{vs, smooth ? Ang<D>::zero() : p.w[i], hot_[s].r, p.invMass[i], smooth ? 0.0 : p.invInertia[i]};
     CollisionBody<D> b2{wl.velocity, Ang<D>::zero(), 0.0, 0.0, 0.0};
     const double gn = dot(vs - wl.velocity, n);
     if (gn >= 0 && !(uRest > gn)) {  // not approaching: nothing happens, no state change
@@ -1679,8 +1678,8 @@ double EdmEngine<D>::nextEventTime() const {
 template <int D>
 std::size_t EdmEngine<D>::memoryBytes() const {
     auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-    return bytes(hot_) + bytes(link_) + bytes(rec_) + bytes(tLast_) + queue_.memoryBytes() + bytes(head_) + bytes(slotOf_) +
-           bytes(free_) + bytes(zoneVolume_) + bytes(centre_) + bytes(nbr_);
+    return bytes(hot_) + bytes(link_) + bytes(rec_) + bytes(tLast_) + queue_.memoryBytes() + bytes(head_) +
+           bytes(slotOf_) + bytes(free_) + bytes(zoneVolume_) + bytes(centre_) + bytes(nbr_);
 }
 
 template class EdmEngine<2>;

@@ -337,9 +337,7 @@ private:
     bool smoothPair(int matA, int matB) const;
     /// World particle i's material; with one material in the table not read (a World-order array: a cache miss
     /// per particle of a collision).
-    int materialOf(std::uint32_t i) const {
-        return w_.contact.nMaterials == 1 ? 0 : w_.particles.material[i];
-    }
+    int materialOf(std::uint32_t i) const { return w_.contact.nMaterials == 1 ? 0 : w_.particles.material[i]; }
     bool tcElastic(std::uint32_t a, std::uint32_t b, double t) const;  // b = kNil: wall or frozen partner
     void notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop, const Vec<D>& P);
 
@@ -364,7 +362,7 @@ private:
         std::uint32_t stamp = 0;
     };
     struct Rec {
-        Kept coll;  // earliest pair or wall event found by the last scan: code, partner's counter
+        Kept coll;                       // earliest pair or wall event found by the last scan: code, partner's counter
         std::uint32_t cell : kCellBits;  // cell index (free slot: head_.size())
         std::uint32_t exit : 3;          // face of the cell crossing (shell exit) found by the last scan: 2 axis + up
         std::uint32_t crossing : 1;      // the pending event is that crossing, not coll
@@ -372,7 +370,7 @@ private:
     };
     std::vector<Rec> rec_;
     std::vector<double> tLast_;  // per slot: time of the last collision (only with the TC model)
-    EventCalendar queue_;  // pending event times
+    EventCalendar queue_;        // pending event times
     // cell grid (singly linked lists: a crossing walks the old cell's few members to unlink)
     std::vector<std::uint32_t> head_;
     static constexpr int kNbrCells = D == 3 ? 27 : 9, kSideCells = D == 3 ? 9 : 3;
@@ -383,7 +381,8 @@ private:
     std::array<int, D> nCell_{};
     std::array<std::uint32_t, D> stride_{};
     Vec<D> cellW_;
-    bool partialScans_ = true;  // crossings scan only the new neighbour cells (docs/edm.md: needs 7 cells per periodic axis)
+    bool partialScans_ =
+        true;  // crossings scan only the new neighbour cells (docs/edm.md: needs 7 cells per periodic axis)
 
     // Neighbour shells (shells_): per slot the box-frame centre of its cube (edge 2 shellHalf_) and a row of rowLen_
     // words in nbr_: the count, then the neighbours, each a slot with the periodic image of the neighbour's centre

@@ -9,9 +9,9 @@ namespace haet {
 
 template <int D>
 struct Domain {
-    Vec<D> lo, hi;                 ///< box corners [m]
+    Vec<D> lo, hi;                   ///< box corners [m]
     std::array<bool, D> periodic{};  ///< periodic per axis
-    Vec<D> gravity;                ///< [m/s^2]
+    Vec<D> gravity;                  ///< [m/s^2]
 
     Vec<D> length() const { return hi - lo; }
     bool fullyPeriodic() const {

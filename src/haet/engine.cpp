@@ -211,7 +211,8 @@ std::size_t HaetEngine<D>::nearIndex(const std::array<int, D>& c) const {
 template <int D>
 void HaetEngine<D>::buildNearGrid() {
     const double edge = 2 * rmax_ + margin_;
-    Vec<D> a = Vec<D>::filled(std::numeric_limits<double>::max()), b = Vec<D>::filled(-std::numeric_limits<double>::max());
+    Vec<D> a = Vec<D>::filled(std::numeric_limits<double>::max()),
+           b = Vec<D>::filled(-std::numeric_limits<double>::max());
     for (const Binned& q : bins_)
         for (int k = 0; k < D; ++k) {
             a[k] = std::min(a[k], q.x[k]);

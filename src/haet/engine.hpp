@@ -20,13 +20,13 @@
 namespace haet {
 
 struct HaetSettings {
-    ZoneSettings zones;      ///< zone edge, phi_on / phi_off, buffer (PHYSICS.md A.2)
-    int relabelEvery = 50;   ///< zones are re-labelled, and particles change mode, every this many steps [steps];
-                             ///< the guard follows the TDM particles at every pair-list build
-    int diluteSteps = 20;    ///< a time-driven particle without contacts returns to EDM once its zone has been
-                             ///< event-driven this long [steps]
-    double dtMin = 0;        ///< modified EDM (A.4): a collision within dtMin of the particle's previous one hands
-                             ///< both particles to the TDM [s]; 0: the contact duration
+    ZoneSettings zones;     ///< zone edge, phi_on / phi_off, buffer (PHYSICS.md A.2)
+    int relabelEvery = 50;  ///< zones are re-labelled, and particles change mode, every this many steps [steps];
+                            ///< the guard follows the TDM particles at every pair-list build
+    int diluteSteps = 20;   ///< a time-driven particle without contacts returns to EDM once its zone has been
+                            ///< event-driven this long [steps]
+    double dtMin = 0;       ///< modified EDM (A.4): a collision within dtMin of the particle's previous one hands
+                            ///< both particles to the TDM [s]; 0: the contact duration
 };
 
 /// Where the energy went, since the start [J]. Potential energy is that of gravity, -m g.x (unwrapped x).
@@ -140,8 +140,8 @@ private:
     std::vector<Binned> bins_;
     NearGrid near_;
     double rmax_ = 0;
-    std::vector<std::uint32_t> watch_;               // event-driven particles in guard cells (World indices)
-    std::size_t watchSorted_ = 0;                    // watch_[0, watchSorted_) is sorted and unique
+    std::vector<std::uint32_t> watch_;  // event-driven particles in guard cells (World indices)
+    std::size_t watchSorted_ = 0;       // watch_[0, watchSorted_) is sorted and unique
     // A watched particle whose gap to the bins cannot reach the margin before `until` (World index; valid while
     // the bins' epoch and the particle's collision count are unchanged).
     struct Quiet {
@@ -152,11 +152,11 @@ private:
     std::vector<Quiet> quiet_;
     std::uint64_t binsEpoch_ = 1;
     std::array<std::vector<std::uint32_t>, D> zoneCellBegin_;  // per axis and zone coordinate: first cell coordinate
-    std::vector<std::uint64_t> lastTdmStep_;  // per zone: last step it was time-driven
-    std::vector<std::uint64_t> denseUntil_;   // per zone: kept dense until this step (modified EDM hand-over)
+    std::vector<std::uint64_t> lastTdmStep_;                   // per zone: last step it was time-driven
+    std::vector<std::uint64_t> denseUntil_;  // per zone: kept dense until this step (modified EDM hand-over)
     std::vector<std::uint8_t> sticky_, contact_;
-    double margin_ = 0;  // distance at which an event-driven particle counts as near a TDM one [m]
-    double vTdmMax_ = 0; // fastest TDM particle at the last relabel [m/s]
+    double margin_ = 0;   // distance at which an event-driven particle counts as near a TDM one [m]
+    double vTdmMax_ = 0;  // fastest TDM particle at the last relabel [m/s]
 
     std::uint64_t steps_ = 0;
     bool frozenModes_ = false;

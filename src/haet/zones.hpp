@@ -12,10 +12,10 @@
 namespace haet {
 
 struct ZoneSettings {
-    double size = 0;     ///< zone edge [m] (rounded so that an integer number of zones spans each axis)
-    double phiOn = 0.3;  ///< dilute -> dense above this smoothed fraction [-]
+    double size = 0;       ///< zone edge [m] (rounded so that an integer number of zones spans each axis)
+    double phiOn = 0.3;    ///< dilute -> dense above this smoothed fraction [-]
     double phiOff = 0.25;  ///< dense -> dilute below this one [-]
-    int buffer = 1;      ///< zones around a dense zone whose particles are time-driven too
+    int buffer = 1;        ///< zones around a dense zone whose particles are time-driven too
 };
 
 template <int D>
@@ -43,9 +43,9 @@ public:
     bool dense(int z) const { return dense_[z]; }
     /// A particle in zone z is time-driven: z or a zone within `buffer` of it is dense.
     bool timeDriven(int z) const { return tdm_[z]; }
-    double fraction(int z) const { return phi_[z]; }          ///< raw fraction of zone z
-    double smoothed(int z) const { return phiSmooth_[z]; }    ///< smoothed fraction of zone z
-    std::size_t changedLast() const { return changed_; }      ///< zones whose timeDriven label changed in the last relabel
+    double fraction(int z) const { return phi_[z]; }        ///< raw fraction of zone z
+    double smoothed(int z) const { return phiSmooth_[z]; }  ///< smoothed fraction of zone z
+    std::size_t changedLast() const { return changed_; }  ///< zones whose timeDriven label changed in the last relabel
     double zoneVolume() const { return cellVolume_; }
     Vec<D> zoneWidth() const { return width_; }
     Vec<D> origin() const { return lo_; }
@@ -64,8 +64,8 @@ private:
     double cellVolume_ = 1;
     std::vector<double> phi_, phiSmooth_;
     std::vector<std::uint8_t> dense_, tdm_;
-    std::vector<double> invCount_;  // 1 / zones in each zone's smoothing block
-    std::vector<double> sum_;                   // scratch of relabel: the smoothing's sums
+    std::vector<double> invCount_;               // 1 / zones in each zone's smoothing block
+    std::vector<double> sum_;                    // scratch of relabel: the smoothing's sums
     std::vector<std::uint8_t> mark_, markNext_;  // and the buffer's dilation
     std::size_t changed_ = 0;
 };

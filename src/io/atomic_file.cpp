@@ -1,10 +1,10 @@
 #include "io/atomic_file.hpp"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
 #include <system_error>
-
-#include <unistd.h>
 
 namespace haet {
 
@@ -21,8 +21,7 @@ std::string lastSystemError() { return errno != 0 ? std::string(std::strerror(er
 
 }  // namespace
 
-AtomicOfstream::AtomicOfstream(std::filesystem::path target)
-    : target_(std::move(target)), temp_(tempPathFor(target_)) {
+AtomicOfstream::AtomicOfstream(std::filesystem::path target) : target_(std::move(target)), temp_(tempPathFor(target_)) {
     errno = 0;
     out_.open(temp_, std::ios::binary | std::ios::trunc);
     if (!out_) throw IoError(target_, "cannot create temporary file " + temp_.string() + ": " + lastSystemError());

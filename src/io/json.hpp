@@ -29,8 +29,7 @@ public:
     JsonObject& add(std::string_view key, const std::vector<double>& values);
     /// Any integer type, written exactly (not through double).
     template <std::integral T>
-        requires(!std::same_as<T, bool>)
-    JsonObject& add(std::string_view key, T value) {
+    requires(!std::same_as<T, bool>) JsonObject& add(std::string_view key, T value) {
         if constexpr (std::is_signed_v<T>)
             return addSigned(key, static_cast<std::int64_t>(value));
         else

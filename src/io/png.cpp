@@ -1,17 +1,17 @@
 #include "io/png.hpp"
 
+#include <cairo.h>
+#include <fmt/format.h>
+#include <png.h>
+
 #include <algorithm>
-#include <csetjmp>
 #include <cmath>
+#include <csetjmp>
 #include <cstdint>
 #include <limits>
 #include <memory>
 #include <stdexcept>
 #include <vector>
-
-#include <cairo.h>
-#include <fmt/format.h>
-#include <png.h>
 
 #include "io/atomic_file.hpp"
 
@@ -67,8 +67,8 @@ bool encodePng(const unsigned char* pixels, int width, int height, int stride, A
         return false;
     }
     png_set_write_fn(png, &out, pngWrite, pngFlush);
-    png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
-                 PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_compression_level(png, 1);
     png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
     png_write_info(png, info);
@@ -330,13 +330,13 @@ void writeLinePlotPng(const std::filesystem::path& path, const std::string& titl
         const double rowH = 18, w = textWidth + 44, h = rowH * labelled.size() + 8;
         // The corner (top right, top left, bottom right, bottom left) that hides the least of the lines,
         // judged by samples along every drawn segment.
-        const double corners[4][2] = {{right - w - 8, top + 8}, {left + 8, top + 8},
-                                      {right - w - 8, bottom - h - 8}, {left + 8, bottom - h - 8}};
+        const double corners[4][2] = {
+            {right - w - 8, top + 8}, {left + 8, top + 8}, {right - w - 8, bottom - h - 8}, {left + 8, bottom - h - 8}};
         std::size_t hidden[4] = {0, 0, 0, 0};
         auto sample = [&](double x, double y) {
             for (std::size_t c = 0; c < 4; ++c)
-                hidden[c] += x >= corners[c][0] && x <= corners[c][0] + w && y >= corners[c][1] &&
-                             y <= corners[c][1] + h;
+                hidden[c] +=
+                    x >= corners[c][0] && x <= corners[c][0] + w && y >= corners[c][1] && y <= corners[c][1] + h;
         };
         for (const PlotSeries& s : series) {
             bool havePrev = false;

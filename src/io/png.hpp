@@ -31,7 +31,7 @@ struct PngScene {
     std::vector<Disk> disks;
     std::vector<Polygon> polygons;
     std::vector<Segment> walls;
-    std::string caption;             ///< drawn at the top left (time, step count, ...)
+    std::string caption;  ///< drawn at the top left (time, step count, ...)
 };
 
 /// Draws the scene on white with thin dark outlines. Throws std::invalid_argument for an empty view or an
@@ -47,11 +47,11 @@ struct PlotSeries {
 };
 
 struct LinePlotOptions {
-    int widthPx = 800;     ///< [px]
-    int heightPx = 500;    ///< [px]
-    bool logX = false;     ///< decades on the x axis (scaling plots)
+    int widthPx = 800;   ///< [px]
+    int heightPx = 500;  ///< [px]
+    bool logX = false;   ///< decades on the x axis (scaling plots)
     bool logY = false;
-    bool markers = true;   ///< a dot on every data point, for series of at most 60 points
+    bool markers = true;  ///< a dot on every data point, for series of at most 60 points
 };
 
 /// A line plot with axes, ticks, grid, axis labels and a legend. Throws as writePng().

@@ -1,9 +1,9 @@
 #include "io/series.hpp"
 
+#include <fmt/format.h>
+
 #include <iterator>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "io/atomic_file.hpp"
 
@@ -46,8 +46,8 @@ SeriesWriter::~SeriesWriter() {
 
 void SeriesWriter::row(const std::vector<std::optional<double>>& values) {
     if (values.size() != columns_)
-        throw std::invalid_argument(fmt::format("SeriesWriter {}: row has {} values for {} columns", path_.string(),
-                                                values.size(), columns_));
+        throw std::invalid_argument(
+            fmt::format("SeriesWriter {}: row has {} values for {} columns", path_.string(), values.size(), columns_));
     auto out = std::back_inserter(text_);
     for (std::size_t k = 0; k < values.size(); ++k) {
         if (k > 0) text_ += ',';

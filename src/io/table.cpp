@@ -63,8 +63,8 @@ CsvTable readCsvTable(const std::filesystem::path& path) {
             const char* e = b + cells[c].size();
             auto [ptr, ec] = std::from_chars(b, e, row[c]);
             if (ec != std::errc() || ptr != e)
-                throw std::invalid_argument(path.string() + ":" + std::to_string(lineNo) + ": column " +
-                                            t.columns[c] + ": not a number: " + cells[c]);
+                throw std::invalid_argument(path.string() + ":" + std::to_string(lineNo) + ": column " + t.columns[c] +
+                                            ": not a number: " + cells[c]);
         }
         t.rows.push_back(std::move(row));
     }

@@ -1,11 +1,11 @@
 #include "io/vtk.hpp"
 
+#include <fmt/format.h>
+
 #include <bit>
 #include <memory>
 #include <stdexcept>
 #include <string_view>
-
-#include <fmt/format.h>
 
 #include "io/atomic_file.hpp"
 
@@ -16,25 +16,33 @@ namespace {
 // The raw blocks are the in-memory bytes; files declare LittleEndian.
 static_assert(std::endian::native == std::endian::little, "VTK raw output assumes a little-endian host");
 
-constexpr std::uint8_t kVtkVertex = 1;   // VTK cell type ids (vtkCellType.h)
+constexpr std::uint8_t kVtkVertex = 1;  // VTK cell type ids (vtkCellType.h)
 constexpr std::uint8_t kVtkPolygon = 7;
 
 const char* typeName(VtkField::Type t) {
     switch (t) {
-        case VtkField::Float64: return "Float64";
-        case VtkField::Int32: return "Int32";
-        case VtkField::Int64: return "Int64";
-        case VtkField::UInt8: return "UInt8";
+        case VtkField::Float64:
+            return "Float64";
+        case VtkField::Int32:
+            return "Int32";
+        case VtkField::Int64:
+            return "Int64";
+        case VtkField::UInt8:
+            return "UInt8";
     }
     throw std::invalid_argument("VtkField: unknown type");
 }
 
 std::size_t typeSize(VtkField::Type t) {
     switch (t) {
-        case VtkField::Float64: return 8;
-        case VtkField::Int32: return 4;
-        case VtkField::Int64: return 8;
-        case VtkField::UInt8: return 1;
+        case VtkField::Float64:
+            return 8;
+        case VtkField::Int32:
+            return 4;
+        case VtkField::Int64:
+            return 8;
+        case VtkField::UInt8:
+            return 1;
     }
     throw std::invalid_argument("VtkField: unknown type");
 }
@@ -44,12 +52,23 @@ std::string xmlEscape(std::string_view s) {
     out.reserve(s.size());
     for (char c : s) {
         switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            case '\'': out += "&apos;"; break;
-            default: out += c;
+            case '&':
+                out += "&amp;";
+                break;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            case '\'':
+                out += "&apos;";
+                break;
+            default:
+                out += c;
         }
     }
     return out;
@@ -61,8 +80,8 @@ class AppendedArrays {
 public:
     /// Declares an array of `tuples` tuples and returns its <DataArray/> tag line. `extra` holds further
     /// attributes, with a leading space.
-    std::string tag(std::string_view name, VtkField::Type type, int components, std::size_t tuples,
-                    const void* data, int indent, std::string_view extra = {}) {
+    std::string tag(std::string_view name, VtkField::Type type, int components, std::size_t tuples, const void* data,
+                    int indent, std::string_view extra = {}) {
         if (components < 1) throw std::invalid_argument(fmt::format("VTK array '{}': components < 1", name));
         if (tuples > 0 && data == nullptr) throw std::invalid_argument(fmt::format("VTK array '{}': no data", name));
         const std::uint64_t bytes = tuples * static_cast<std::size_t>(components) * typeSize(type);
@@ -124,8 +143,7 @@ std::string fileHead(std::string_view type) {
 
 // VTK's reader needs NumberOfTuples on FieldData arrays (there is no point or cell count to go by).
 std::string timeValue(AppendedArrays& arrays, const double* time) {
-    return "    <FieldData>\n" +
-           arrays.tag("TimeValue", VtkField::Float64, 1, 1, time, 6, " NumberOfTuples=\"1\"") +
+    return "    <FieldData>\n" + arrays.tag("TimeValue", VtkField::Float64, 1, 1, time, 6, " NumberOfTuples=\"1\"") +
            "    </FieldData>\n";
 }
 
@@ -168,15 +186,14 @@ void writeVtuPoints(const std::filesystem::path& path, std::size_t n, const doub
 }
 
 void writeVtuPolygons(const std::filesystem::path& path, std::span<const double> xyz,
-                      std::span<const std::uint32_t> offsets, const std::vector<VtkField>& cellData,
-                      double time) {
+                      std::span<const std::uint32_t> offsets, const std::vector<VtkField>& cellData, double time) {
     if (xyz.size() % 3 != 0) throw std::invalid_argument("writeVtuPolygons: xyz size is not a multiple of 3");
     const std::size_t nVertices = xyz.size() / 3;
     const std::size_t nPolygons = offsets.empty() ? 0 : offsets.size() - 1;
     if (!offsets.empty() && (offsets.front() != 0 || offsets.back() != nVertices))
-        throw std::invalid_argument(fmt::format(
-            "writeVtuPolygons: offsets must run from 0 to the vertex count {} (got {}..{})", nVertices,
-            offsets.front(), offsets.back()));
+        throw std::invalid_argument(
+            fmt::format("writeVtuPolygons: offsets must run from 0 to the vertex count {} (got {}..{})", nVertices,
+                        offsets.front(), offsets.back()));
     std::vector<std::int64_t> connectivity(nVertices), cellEnd(nPolygons);
     for (std::size_t i = 0; i < nVertices; ++i) connectivity[i] = static_cast<std::int64_t>(i);
     for (std::size_t k = 0; k < nPolygons; ++k) {
@@ -207,11 +224,9 @@ void writeVtpWalls(const std::filesystem::path& path, const std::vector<WallQuad
         "    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
         "NumberOfPolys=\"{}\">\n",
         4 * n, n);
-    head += "      <CellData>\n" +
-            arrays.tag("wall_id", VtkField::Int32, 1, n, arrays.keep(std::move(ids)), 8) +
+    head += "      <CellData>\n" + arrays.tag("wall_id", VtkField::Int32, 1, n, arrays.keep(std::move(ids)), 8) +
             "      </CellData>\n";
-    head += "      <Points>\n" +
-            arrays.tag("Points", VtkField::Float64, 3, 4 * n, arrays.keep(std::move(xyz)), 8) +
+    head += "      <Points>\n" + arrays.tag("Points", VtkField::Float64, 3, 4 * n, arrays.keep(std::move(xyz)), 8) +
             "      </Points>\n";
     head += "      <Polys>\n";
     head += arrays.tag("connectivity", VtkField::Int64, 1, 4 * n, arrays.keep(std::move(connectivity)), 8);

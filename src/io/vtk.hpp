@@ -20,7 +20,7 @@ namespace haet {
 struct VtkField {
     enum Type { Float64, Int32, Int64, UInt8 };
     std::string name;
-    int components = 1;          ///< values per point or cell (3 for a vector)
+    int components = 1;  ///< values per point or cell (3 for a vector)
     Type type = Float64;
     const void* data = nullptr;  ///< count*components values of `type`, interleaved (x0 y0 z0 x1 ...)
 };
@@ -35,8 +35,7 @@ void writeVtuPoints(const std::filesystem::path& path, std::size_t n, const doub
 /// entry per polygon plus one: polygon k uses vertices [offsets[k], offsets[k+1]), offsets.front() == 0 and
 /// offsets.back() == vertex count. Each cellData field holds one tuple per polygon.
 void writeVtuPolygons(const std::filesystem::path& path, std::span<const double> xyz,
-                      std::span<const std::uint32_t> offsets, const std::vector<VtkField>& cellData,
-                      double time);
+                      std::span<const std::uint32_t> offsets, const std::vector<VtkField>& cellData, double time);
 
 /// Writes a uniform grid of cells as ImageData (.vti): dims cells per axis (1 for an unused axis), origin and
 /// spacing [m]; each cellData field holds one tuple per cell, x fastest.
@@ -46,7 +45,7 @@ void writeVtiCells(const std::filesystem::path& path, std::array<int, 3> dims, s
 /// One planar wall as a quadrilateral (2D walls are passed as thin quads by the caller).
 struct WallQuad {
     std::array<std::array<double, 3>, 4> corners{};  ///< [m], in order around the quad
-    int id = 0;                                       ///< written as cell data "wall_id"
+    int id = 0;                                      ///< written as cell data "wall_id"
 };
 
 /// Writes the walls as PolyData, one polygon per wall.

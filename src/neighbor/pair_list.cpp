@@ -1,10 +1,10 @@
 #include "neighbor/pair_list.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-
-#include <omp.h>
 
 namespace haet {
 namespace {
@@ -69,7 +69,10 @@ int neighbourCellsOf(const Grid<D>& g, const Domain<D>& dom, const std::array<in
             int ck = c[k] + (t % 3) - 1;
             t /= 3;
             if (ck < 0 || ck >= g.n[k]) {
-                if (!dom.periodic[k]) { ok = false; break; }
+                if (!dom.periodic[k]) {
+                    ok = false;
+                    break;
+                }
                 ck = (ck + g.n[k]) % g.n[k];
             }
             cc[k] = ck;
@@ -276,7 +279,8 @@ void collectPairs(std::size_t n, const Candidates& candidates, PairList<D>& out)
     out.shift.resize(out.first[n]);
     std::size_t o = 0;
     for (std::size_t t = 0; t < used; ++t) {
-        std::copy(parts[t].partner.begin(), parts[t].partner.end(), out.partner.begin() + static_cast<std::ptrdiff_t>(o));
+        std::copy(parts[t].partner.begin(), parts[t].partner.end(),
+                  out.partner.begin() + static_cast<std::ptrdiff_t>(o));
         std::copy(parts[t].shift.begin(), parts[t].shift.end(), out.shift.begin() + static_cast<std::ptrdiff_t>(o));
         o += parts[t].partner.size();
         parts[t] = Part{};
@@ -294,9 +298,12 @@ void finishList(std::size_t n, const PairList<D>& old, PairList<D>& out) {
         for (std::size_t i = 0; i < n; ++i) {  // merge two j-sorted lists
             std::uint32_t a = old.first[i], ae = old.first[i + 1], b = out.first[i], be = out.first[i + 1];
             while (a < ae && b < be) {
-                if (old.partner[a] < out.partner[b]) ++a;
-                else if (old.partner[a] > out.partner[b]) ++b;
-                else out.history[b++] = old.history[a++];
+                if (old.partner[a] < out.partner[b])
+                    ++a;
+                else if (old.partner[a] > out.partner[b])
+                    ++b;
+                else
+                    out.history[b++] = old.history[a++];
             }
         }
     }
@@ -413,8 +420,10 @@ void buildThreadSplit(PairList<D>& list, int ranges) {
         std::size_t lo = s.start[r - 1], hi = n;  // first i with work(i) >= goal
         while (lo < hi) {
             const std::size_t mid = (lo + hi) / 2;
-            if (work(mid) < goal) lo = mid + 1;
-            else hi = mid;
+            if (work(mid) < goal)
+                lo = mid + 1;
+            else
+                hi = mid;
         }
         s.start[r] = static_cast<std::uint32_t>(lo);
     }
@@ -612,7 +621,10 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     std::vector<std::uint32_t> inv(nOld, kNone);
     for (std::size_t k = 0; k < n; ++k)
         if (order[k] < nOld) inv[order[k]] = static_cast<std::uint32_t>(k);
-    struct Entry { std::uint32_t i, j; Vec<D> h; };
+    struct Entry {
+        std::uint32_t i, j;
+        Vec<D> h;
+    };
     std::vector<Entry> kept;
     if (!list.history.empty()) {
         std::size_t touching = 0;
@@ -624,11 +636,15 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
                 std::uint32_t a = inv[i], b = list.partner[k] < nOld ? inv[list.partner[k]] : kNone;
                 if (a == kNone || b == kNone) continue;  // a particle that left: its contacts end
                 Vec<D> h = list.history[k];
-                if (a > b) { std::swap(a, b); h = -h; }  // xi of (j, i) is -xi of (i, j)
+                if (a > b) {
+                    std::swap(a, b);
+                    h = -h;
+                }  // xi of (j, i) is -xi of (i, j)
                 kept.push_back({a, b, h});
             }
     }
-    std::sort(kept.begin(), kept.end(), [](const Entry& x, const Entry& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
+    std::sort(kept.begin(), kept.end(),
+              [](const Entry& x, const Entry& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
     list.first.assign(n + 1, 0);
     for (const auto& e : kept) ++list.first[e.i + 1];
     for (std::size_t i = 0; i < n; ++i) list.first[i + 1] += list.first[i];
@@ -642,16 +658,16 @@ void permutePairList(PairList<D>& list, const std::vector<std::uint32_t>& order)
     list.dropDerived();
 }
 
-#define HAET_INSTANTIATE(D)                                                                                     \
-    template void buildPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&,              \
-                                   const PairList<D>&, PairList<D>&);                                           \
-    template void buildAllPairs<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, PairList<D>&); \
-    template void buildThreadSplit<D>(PairList<D>&, int);                                                       \
-    template void keepTouchingPairs<D>(PairList<D>&);                                                           \
-    template void wrapPositions<D>(Particles<D>&, const Domain<D>&);                                            \
-    template std::vector<std::uint32_t> spatialOrder<D>(const Particles<D>&, const Domain<D>&, double);         \
-    template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);                        \
-    template void remapPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&,               \
+#define HAET_INSTANTIATE(D)                                                                                            \
+    template void buildPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, const PairList<D>&, \
+                                   PairList<D>&);                                                                      \
+    template void buildAllPairs<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&, PairList<D>&);      \
+    template void buildThreadSplit<D>(PairList<D>&, int);                                                              \
+    template void keepTouchingPairs<D>(PairList<D>&);                                                                  \
+    template void wrapPositions<D>(Particles<D>&, const Domain<D>&);                                                   \
+    template std::vector<std::uint32_t> spatialOrder<D>(const Particles<D>&, const Domain<D>&, double);                \
+    template void permutePairList<D>(PairList<D>&, const std::vector<std::uint32_t>&);                                 \
+    template void remapPairList<D>(const Particles<D>&, const Domain<D>&, const NeighborSettings&,                     \
                                    const std::vector<std::uint32_t>&, PairList<D>&, const Vec<D>*);
 HAET_INSTANTIATE(2)
 HAET_INSTANTIATE(3)

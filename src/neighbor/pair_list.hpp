@@ -30,14 +30,14 @@ struct ThreadSplit {
 
 template <int D>
 struct PairList {
-    std::vector<std::uint32_t> first;   ///< CSR offsets, size n+1
-    std::vector<std::uint32_t> partner; ///< j of each pair
-    std::vector<std::uint8_t> shift;    ///< image-shift code of each pair, index into shiftVec
-    std::vector<Vec<D>> history;        ///< tangential spring of each pair [m]; zero when not touching
-    std::vector<Vec<D>> shiftVec;       ///< 3^D shift vectors [m]
+    std::vector<std::uint32_t> first;    ///< CSR offsets, size n+1
+    std::vector<std::uint32_t> partner;  ///< j of each pair
+    std::vector<std::uint8_t> shift;     ///< image-shift code of each pair, index into shiftVec
+    std::vector<Vec<D>> history;         ///< tangential spring of each pair [m]; zero when not touching
+    std::vector<Vec<D>> shiftVec;        ///< 3^D shift vectors [m]
     // Made from the list when first needed, dropped by every change of the list (dropDerived):
-    ThreadSplit split;                  ///< the threaded force loops' split (buildThreadSplit)
-    std::vector<std::uint32_t> owner;   ///< owner i of each pair (makeOwners), for the four-wide contact tests
+    ThreadSplit split;                 ///< the threaded force loops' split (buildThreadSplit)
+    std::vector<std::uint32_t> owner;  ///< owner i of each pair (makeOwners), for the four-wide contact tests
 
     /// Forgets what was made from the list (after the list changed).
     void dropDerived() {
@@ -57,7 +57,7 @@ struct PairList {
 };
 
 struct NeighborSettings {
-    double skin = 0;               ///< [m]
+    double skin = 0;                 ///< [m]
     bool excludeFrozenPairs = true;  ///< pairs of two frozen particles never matter
 };
 

@@ -37,11 +37,11 @@ namespace haet::polygon {
 
 /// Coefficients of the polygon law for one material pair (built once, contact/setup.cpp).
 struct PolygonCoeffs {
-    double young = 0;   ///< Y [N/m] (2D: stiffness per length), F_el = Y A / l
-    double gamma = 0;   ///< normal damping, dimensionless (PHYSICS.md G.3)
-    double kt = 0;      ///< tangential spring stiffness [N/m]; 0 = no tangential force
-    double gammaT = 0;  ///< tangential damping: F = -gammaT sqrt(k_t m_t) g_t [-]
-    double mu = 0;      ///< Coulomb friction [-]
+    double young = 0;                          ///< Y [N/m] (2D: stiffness per length), F_el = Y A / l
+    double gamma = 0;                          ///< normal damping, dimensionless (PHYSICS.md G.3)
+    double kt = 0;                             ///< tangential spring stiffness [N/m]; 0 = no tangential force
+    double gammaT = 0;                         ///< tangential damping: F = -gammaT sqrt(k_t m_t) g_t [-]
+    double mu = 0;                             ///< Coulomb friction [-]
     PolygonLaw law = PolygonLaw::OverlapArea;  ///< normal force: G.3, or the energy-conserving variant
 };
 
@@ -95,10 +95,10 @@ inline double areaRate(const Overlap& o, const BodyState& bi, const BodyState& b
 /// when the centres coincide; the potential law's force then vanishes with |c| (a depth that max_overlap stops).
 /// Always inlined: as a call (its frame, register saves and the copies of its arguments) it cost the polygon force
 /// pass 3 % more instructions.
-[[gnu::always_inline]] inline ContactForce polygonContact(const PolygonCoeffs& c, const Overlap& o,
-                                                          const BodyState& bi, const BodyState& bj,
-                                                          const V2* wallNormal, const PairLengths& len,
-                                                          bool attraction, bool friction, double dt, V2& xi) {
+[[gnu::always_inline]] inline ContactForce polygonContact(const PolygonCoeffs& c, const Overlap& o, const BodyState& bi,
+                                                          const BodyState& bj, const V2* wallNormal,
+                                                          const PairLengths& len, bool attraction, bool friction,
+                                                          double dt, V2& xi) {
     ContactForce out;
     const double clen = norm(o.chord);
     const bool hasChord = clen > 1e-12 * std::sqrt(o.area);

@@ -12,10 +12,10 @@
 // particle is the partner (increasing pair index), its own pairs, its walls. So is the pass: one thread runs once
 // over the particles, each finished (walls, statistics) right after its own pairs; T threads evaluate the cross
 // pairs of PairList::split first, then run that pass over their ranges.
+#include <omp.h>
+
 #include <cmath>
 #include <vector>
-
-#include <omp.h>
 
 #include "contact/setup.hpp"
 #include "polygon/contact.hpp"
@@ -41,15 +41,15 @@ struct PolygonCrossPair {
 
 /// Work arrays of the polygon loop, kept between steps so that no step allocates.
 struct PolygonScratch {
-    std::vector<V2> rotated;        ///< vertices of every shape turned by its particle's angle (body -> world
-                                    ///< without the translation) [m]
-    std::vector<double> inradius;   ///< per shape: distance from the centroid to the nearest edge line [m]
-    std::vector<double> pairEnergy; ///< estimated elastic energy of each pair [J] (contactEnergy)
-    std::vector<double> wallEnergy; ///< per particle: estimated elastic energy of its wall contacts [J]
-    V2 gravity{};                   ///< [m/s^2]
+    std::vector<V2> rotated;              ///< vertices of every shape turned by its particle's angle (body -> world
+                                          ///< without the translation) [m]
+    std::vector<double> inradius;         ///< per shape: distance from the centroid to the nearest edge line [m]
+    std::vector<double> pairEnergy;       ///< estimated elastic energy of each pair [J] (contactEnergy)
+    std::vector<double> wallEnergy;       ///< per particle: estimated elastic energy of its wall contacts [J]
+    V2 gravity{};                         ///< [m/s^2]
     std::vector<PolygonCrossPair> cross;  ///< threaded path: the cross pairs (PairList::split)
-    std::vector<double> virial;     ///< threaded path, per particle: sum over own pairs of r_ij . F_ij [N m]
-    std::vector<RangeTally> tally;  ///< threaded path: per-range statistics
+    std::vector<double> virial;           ///< threaded path, per particle: sum over own pairs of r_ij . F_ij [N m]
+    std::vector<RangeTally> tally;        ///< threaded path: per-range statistics
 };
 
 /// Particle i as a body of the contact law (BodyState::x left at zero: the caller sets the frame).
@@ -150,8 +150,8 @@ inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
     const PolygonCoeffs& c = cs.polygonPair(p.material[i], p.material[j]);
     const double rmin = std::min(ri, rj);
     const PairLengths len = pairLengths(ri, rj);
-    const ContactForce cf = polygonContact(c, o, bi, bj, nullptr, len, cs.attraction,
-                                           cs.tangential == TangentialLaw::Spring, dt, hist);
+    const ContactForce cf =
+        polygonContact(c, o, bi, bj, nullptr, len, cs.attraction, cs.tangential == TangentialLaw::Spring, dt, hist);
     out.f = cf.f;
     out.ti = cf.torqueI;
     out.tj = cf.torqueJ;
@@ -300,8 +300,10 @@ RangeTally polygonRange(Particles<2>& p, const PairList<2>& pl, const std::vecto
         tq[i][0] = ti;
         ps.wallEnergy[i] = wallEnergy;
         out.contacts += nc;
-        if constexpr (kCross) virial[i] = vir;
-        else *virialSum += vir;
+        if constexpr (kCross)
+            virial[i] = vir;
+        else
+            *virialSum += vir;
         if (worst > out.maxOverlapRatio) {
             out.maxOverlapRatio = worst;
             out.worstParticle = i;
@@ -318,8 +320,8 @@ RangeTally polygonRange(Particles<2>& p, const PairList<2>& pl, const std::vecto
 /// tdm/forces.hpp; every particle sums its contributions in the same order either way.
 template <class Normal, class Tangential>
 ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vector<Wall<2>>& walls,
-                                std::vector<V2>& wallHistory, const ContactSetup& cs, const Domain<2>& dom,
-                                double time, double dt, const V2* sv, const Ang<2>* sw, PolygonScratch& ps) {
+                                std::vector<V2>& wallHistory, const ContactSetup& cs, const Domain<2>& dom, double time,
+                                double dt, const V2* sv, const Ang<2>* sw, PolygonScratch& ps) {
     const std::size_t n = p.tdmCount();
     rotateShapes(p, ps);
     ps.pairEnergy.resize(pl.size());  // both written for every pair and particle below
@@ -330,8 +332,8 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
     // One pair, whichever its kind: force on i and the torques on i and j.
     const PairInputs<2> in = pairInputs(p, pl, cs, sv, sw, dt);
     // Inlined into each pass (GCC leaves a lambda used in three places out of line: 3 % more instructions).
-    auto pair = [&](std::size_t i, std::uint32_t k, PairResult& r, double& worst, double& vir)
-                    __attribute__((always_inline)) {
+    auto pair = [&](std::size_t i, std::uint32_t k, PairResult & r, double& worst, double& vir)
+        __attribute__((always_inline)) {
         const std::uint32_t j = pl.partner[k];
         if (p.shape[i] == kNoShape && p.shape[j] == kNoShape) {
             PairForce<2> pf;
@@ -347,9 +349,9 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
 
     ForceStats st;
     if (nt <= 1) {
-        const RangeTally t = polygonRange<Normal, Tangential, false>(p, pl, walls, wallHistory, cs, time, dt, sv, sw,
-                                                                     ps, 0, n, nullptr, 0, nullptr, nullptr, nullptr,
-                                                                     &st.virial, pair);
+        const RangeTally t =
+            polygonRange<Normal, Tangential, false>(p, pl, walls, wallHistory, cs, time, dt, sv, sw, ps, 0, n, nullptr,
+                                                    0, nullptr, nullptr, nullptr, &st.virial, pair);
         addTally(st, t);
         return st;
     }
@@ -376,10 +378,10 @@ ForceStats computePolygonForces(Particles<2>& p, PairList<2>& pl, const std::vec
 #pragma omp for schedule(static, 1)
         for (int r = 0; r < nt; ++r) {
             const std::uint64_t* ci = sp.crossIn.data();
-            ps.tally[r] = polygonRange<Normal, Tangential, true>(
-                p, pl, walls, wallHistory, cs, time, dt, sv, sw, ps, sp.start[r], sp.start[r + 1], cross,
-                sp.crossFirst[r], ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1], ps.virial.data(), nullptr,
-                pair);
+            ps.tally[r] = polygonRange<Normal, Tangential, true>(p, pl, walls, wallHistory, cs, time, dt, sv, sw, ps,
+                                                                 sp.start[r], sp.start[r + 1], cross, sp.crossFirst[r],
+                                                                 ci + sp.crossInFirst[r], ci + sp.crossInFirst[r + 1],
+                                                                 ps.virial.data(), nullptr, pair);
         }
     }
     // The one-thread reductions, in the same order.

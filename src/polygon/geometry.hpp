@@ -209,11 +209,11 @@ inline bool separatedAlong(const V2& u, double shift, const V2* P, int np, const
 
 /// The overlap of two bodies as the force law needs it. Coordinates are those of the inputs.
 struct Overlap {
-    double area = 0;  ///< [m^2]; 0 when the bodies do not overlap (then the other members are unset)
-    V2 centroid{};    ///< C [m]
-    V2 chord{};       ///< c: sum of the first body's outline pieces inside the second [m] (see the file comment)
-    double spin = 0;  ///< s: sum over those pieces of (|b - C|^2 - |a - C|^2)/2 [m^2]
-    int vertices = 0; ///< vertices of the overlap polygon (0 for a circle)
+    double area = 0;   ///< [m^2]; 0 when the bodies do not overlap (then the other members are unset)
+    V2 centroid{};     ///< C [m]
+    V2 chord{};        ///< c: sum of the first body's outline pieces inside the second [m] (see the file comment)
+    double spin = 0;   ///< s: sum over those pieces of (|b - C|^2 - |a - C|^2)/2 [m^2]
+    int vertices = 0;  ///< vertices of the overlap polygon (0 for a circle)
 };
 
 /// Overlap of the convex counter-clockwise polygons P (the first body) and Q by Sutherland-Hodgman clipping of P
@@ -341,7 +341,7 @@ inline bool twoCrossing(const V2* P, int np, const V2* Q, int nq, const V2& pCen
     const double r2 = pRadius * pRadius;
     for (int e = 0; e < nq; ++e) {
         const V2 q0 = Q[e] - pShift, d = Q[e + 1 == nq ? 0 : e + 1] - Q[e];
-        const double sc = cross2(d, centre - q0);  // |d| x the centre's distance inside the edge's line
+        const double sc = cross2(d, centre - q0);          // |d| x the centre's distance inside the edge's line
         if (sc > 0 && sc * sc >= r2 * norm2(d)) continue;  // cannot reach P's bounding circle
         const Lanes dx(d[0]), dy(d[1]), qx(q0[0]), qy(q0[1]);
         std::uint32_t out = 0;

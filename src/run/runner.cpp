@@ -1,5 +1,7 @@
 #include "run/runner.hpp"
 
+#include <fmt/format.h>
+#include <omp.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -9,18 +11,16 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <fmt/format.h>
-#include <omp.h>
 #include <ostream>
 
 #include "core/version.hpp"
+#include "edm/engine.hpp"
+#include "haet/engine.hpp"
 #include "io/atomic_file.hpp"
 #include "io/json.hpp"
 #include "io/png.hpp"
 #include "io/series.hpp"
 #include "io/vtk.hpp"
-#include "edm/engine.hpp"
-#include "haet/engine.hpp"
 #include "polygon/output.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
@@ -72,15 +72,15 @@ public:
     virtual void synchronise() {}
     /// Time resolution of the engine: the loop treats times closer than this as equal [s].
     virtual double timeTolerance() const = 0;
-    virtual std::uint64_t steps() const = 0;          ///< time steps taken (0 for a pure event-driven run)
-    virtual std::size_t contacts() const = 0;         ///< enduring contacts now
+    virtual std::uint64_t steps() const = 0;   ///< time steps taken (0 for a pure event-driven run)
+    virtual std::size_t contacts() const = 0;  ///< enduring contacts now
     virtual double maxOverlapRatio() const = 0;
-    virtual double elasticEnergy() const = 0;         ///< energy stored in contacts [J]
+    virtual double elasticEnergy() const = 0;  ///< energy stored in contacts [J]
     /// Sum of r_ij . F_ij (soft contacts) plus collision virial / window (hard collisions) [J].
     virtual double virial(double window) = 0;
     virtual std::vector<std::string> extraColumns() const = 0;
     virtual std::vector<std::optional<double>> extraRow() const = 0;
-    virtual void describe(JsonObject& j) const = 0;   ///< engine facts for run.json
+    virtual void describe(JsonObject& j) const = 0;  ///< engine facts for run.json
     /// Hybrid runs: the engine, for the mode field, the zone grid and the picture. Others: nullptr.
     virtual const HaetEngine<D>* hybrid() const { return nullptr; }
 };
@@ -165,15 +165,15 @@ public:
         return eng_.tdm().pairVirial() + (window > 0 ? collisions / window : 0.0);
     }
     std::vector<std::string> extraColumns() const override {
-        return {"n_tdm", "n_edm", "events", "collisions", "tdm_steps", "to_tdm", "to_edm", "tc_handovers",
-                "dissipated_tdm", "dissipated_edm", "energy_unaccounted"};
+        return {"n_tdm",  "n_edm",        "events",         "collisions",     "tdm_steps",         "to_tdm",
+                "to_edm", "tc_handovers", "dissipated_tdm", "dissipated_edm", "energy_unaccounted"};
     }
     std::vector<std::optional<double>> extraRow() const override {
         const HaetEnergy e = eng_.energy();
         const HaetCounters& c = eng_.counters();
-        return {double(eng_.nTdm()), double(eng_.nEdm()), double(eng_.events()), double(eng_.collisions()),
-                double(eng_.steps()), double(c.toTdm), double(c.toEdm), double(c.tcHandovers), e.dissipatedTdm,
-                e.dissipatedEdm, e.unaccounted};
+        return {double(eng_.nTdm()),  double(eng_.nEdm()), double(eng_.events()), double(eng_.collisions()),
+                double(eng_.steps()), double(c.toTdm),     double(c.toEdm),       double(c.tcHandovers),
+                e.dissipatedTdm,      e.dissipatedEdm,     e.unaccounted};
     }
     void describe(JsonObject& j) const override {
         const HaetCounters& c = eng_.counters();
@@ -215,7 +215,7 @@ inline EdmSettings edmSettings(const Scenario& sc) {
     EdmSettings es;
     es.cellSize = sc.edm.cellSize.value_or(0.0);
     es.tangential = sc.edm.tangential == EdmTangential::Constant ? EdmSettings::Tangential::Constant
-                                                                  : EdmSettings::Tangential::Walton;
+                                                                 : EdmSettings::Tangential::Walton;
     es.tcModel = sc.edm.tcModel;
     es.tcTime = sc.edm.tcTime.value_or(0.0);
     return es;
@@ -263,8 +263,10 @@ public:
                 vel[3 * i + k] = p.v[i][k];
                 if (forces) force[3 * i + k] = p.f[i][k];
             }
-            if constexpr (D == 2) spin[3 * i + 2] = p.w[i][0];
-            else for (int k = 0; k < 3; ++k) spin[3 * i + k] = p.w[i][k];
+            if constexpr (D == 2)
+                spin[3 * i + 2] = p.w[i][0];
+            else
+                for (int k = 0; k < 3; ++k) spin[3 * i + k] = p.w[i][k];
             rad[i] = p.radius[i];
             ids[i] = static_cast<std::int64_t>(p.id[i]);
             mat[i] = p.material[i];
@@ -346,8 +348,8 @@ private:
             for (int k = 0; k < 3; ++k) off += (mid[k] - c[k]) * n[k];
             for (int k = 0; k < 3; ++k) c[k] = mid[k] - off * n[k];
             // Two tangent directions.
-            std::array<double, 3> a = std::abs(n[0]) < 0.9 ? std::array<double, 3>{1, 0, 0}
-                                                            : std::array<double, 3>{0, 1, 0};
+            std::array<double, 3> a =
+                std::abs(n[0]) < 0.9 ? std::array<double, 3>{1, 0, 0} : std::array<double, 3>{0, 1, 0};
             if (D == 2) a = {-n[1], n[0], 0};
             double an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
             for (int k = 0; k < 3; ++k) a[k] -= an * n[k];
@@ -389,7 +391,8 @@ void writePicture(const World<2>& w, const std::filesystem::path& path, bool byM
         } else if (byMode) {
             const double k = 0.55 + 0.45 * std::sqrt(s);
             auto ch = [&](double c) { return static_cast<std::uint32_t>(std::clamp(c * k, 0.0, 255.0)); };
-            colour = i < p.tdmCount() ? (ch(40) << 16) | (ch(110) << 8) | ch(235) : (ch(255) << 16) | (ch(150) << 8) | ch(20);
+            colour = i < p.tdmCount() ? (ch(40) << 16) | (ch(110) << 8) | ch(235)
+                                      : (ch(255) << 16) | (ch(150) << 8) | ch(20);
         } else {
             const auto r = static_cast<std::uint32_t>(60 + 195 * s), b = static_cast<std::uint32_t>(255 - 195 * s);
             colour = (r << 16) | (90u << 8) | b;
@@ -409,7 +412,8 @@ void writePicture(const World<2>& w, const std::filesystem::path& path, bool byM
         scene.caption = fmt::format("t = {:.4g} s, {} particles: {} time-driven (blue), {} event-driven (orange)",
                                     w.time, p.size(), p.tdmCount(), p.size() - p.tdmCount());
     else
-        scene.caption = fmt::format("t = {:.4g} s, {} particles (colour: speed, max {:.3g} m/s)", w.time, p.size(), vmax);
+        scene.caption =
+            fmt::format("t = {:.4g} s, {} particles (colour: speed, max {:.3g} m/s)", w.time, p.size(), vmax);
     writePng(path, scene);
 }
 
@@ -452,9 +456,9 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
 
     const double seriesPeriod = sc.output.seriesPeriod > 0 ? sc.output.seriesPeriod : sc.duration / 100;
     const double snapPeriod = sc.output.snapshotPeriod == 0 ? sc.duration / 20 : sc.output.snapshotPeriod;
-    std::vector<std::string> columns = {"time", "step", "kinetic_energy", "rotational_energy", "potential_energy",
-                                        "elastic_energy", "total_energy", "n_particles", "n_contacts",
-                                        "max_overlap_ratio", "pressure"};
+    std::vector<std::string> columns = {
+        "time",         "step",        "kinetic_energy", "rotational_energy", "potential_energy", "elastic_energy",
+        "total_energy", "n_particles", "n_contacts",     "max_overlap_ratio", "pressure"};
     for (auto& c : eng->extraColumns()) columns.push_back(c);
     SeriesWriter series(dir / "series.csv", columns);
     SnapshotWriter<D> snaps(dir);
@@ -467,10 +471,17 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         std::optional<double> pressure;
         const double vir = eng->virial(window);
         if (world.domain.fullyPeriodic()) pressure = (e.mv2 + vir) / (D * world.domain.volume());
-        std::vector<std::optional<double>> row = {
-            world.time, double(eng->steps()), e.kinetic, e.rotational, e.potential, elastic,
-            e.kinetic + e.rotational + e.potential + elastic, double(world.particles.size()),
-            double(eng->contacts()), eng->maxOverlapRatio(), pressure};
+        std::vector<std::optional<double>> row = {world.time,
+                                                  double(eng->steps()),
+                                                  e.kinetic,
+                                                  e.rotational,
+                                                  e.potential,
+                                                  elastic,
+                                                  e.kinetic + e.rotational + e.potential + elastic,
+                                                  double(world.particles.size()),
+                                                  double(eng->contacts()),
+                                                  eng->maxOverlapRatio(),
+                                                  pressure};
         for (auto& v : eng->extraRow()) row.push_back(v);
         series.row(row);
     };
@@ -544,8 +555,8 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     if constexpr (D == 2) writePicture(world, dir / "final.png", eng->hybrid() != nullptr);
     if (!opt.quiet) {
         const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-        log << fmt::format("{} ({}): {} particles, simulated {:.4g} s in {:.2f} s wall time; outputs in {}\n",
-                           sc.name, eng->method(), world.particles.size(), world.time, wall, dir.string());
+        log << fmt::format("{} ({}): {} particles, simulated {:.4g} s in {:.2f} s wall time; outputs in {}\n", sc.name,
+                           eng->method(), world.particles.size(), world.time, wall, dir.string());
     }
     return status;
 }
@@ -564,8 +575,7 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
     // shift, spring).
     const std::size_t gearHistory = 4 * (sizeof(Vec<D>) + sizeof(Ang<D>));
     const std::size_t perParticle = sizeof(Vec<D>) * 5 + sizeof(Ang<D>) * (world.particles.hasPolygons() ? 4 : 3) +
-                                    8 * 5 + 4 * D + 8 +
-                                    (ts.integrator == IntegratorKind::Gear5 ? gearHistory : 0);
+                                    8 * 5 + 4 * D + 8 + (ts.integrator == IntegratorKind::Gear5 ? gearHistory : 0);
     const std::size_t perPair = 4 + 4 + 1 + sizeof(Vec<D>);
     const double steps = std::ceil(sc.duration / ts.dt);
     out << fmt::format("scenario   {} ({})\n", sc.name, sc.path);
@@ -582,10 +592,9 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
                                : "overlap-area law Y A / l, PHYSICS.md G.3");
     out << fmt::format("contact    {} normal law, {} tangential; contact duration t_c = {:.4g} s ({})\n",
                        sc.contact.normal == NormalLaw::Linear ? "linear" : "hertz",
-                       sc.contact.tangential == TangentialLaw::Spring ? "spring" : "no",
-                       world.contact.contactTime, world.contact.contactTimeNote);
-    out << fmt::format("time step  dt = {:.4g} s ({}); {:.0f} steps for {:.4g} s\n", ts.dt, dtNote, steps,
-                       sc.duration);
+                       sc.contact.tangential == TangentialLaw::Spring ? "spring" : "no", world.contact.contactTime,
+                       world.contact.contactTimeNote);
+    out << fmt::format("time step  dt = {:.4g} s ({}); {:.0f} steps for {:.4g} s\n", ts.dt, dtNote, steps, sc.duration);
     out << fmt::format("neighbours skin {:.4g} m, {} pairs in the initial list\n", ts.skin, pairs);
     out << fmt::format("memory     about {:.1f} MB ({} bytes per particle)\n",
                        (n * perParticle + pairs * perPair) / 1e6, n ? (n * perParticle + pairs * perPair) / n : 0);
@@ -634,18 +643,20 @@ void describeHaet(const Scenario& sc, std::ostream& out) {
     const ZoneGrid<D>& z = eng.zones();
     std::string dims;
     for (int k = 0; k < D; ++k) dims += (k ? " x " : "") + std::to_string(z.dims()[k]);
-    out << fmt::format("zones      edge {:.4g} m ({} zones), phi_on {:.3g}, phi_off {:.3g}, buffer {}, "
-                       "relabel every {} steps, dilute_steps {}\n",
-                       hs.zones.size, dims, hs.zones.phiOn, hs.zones.phiOff, hs.zones.buffer, hs.relabelEvery,
-                       hs.diluteSteps);
+    out << fmt::format(
+        "zones      edge {:.4g} m ({} zones), phi_on {:.3g}, phi_off {:.3g}, buffer {}, "
+        "relabel every {} steps, dilute_steps {}\n",
+        hs.zones.size, dims, hs.zones.phiOn, hs.zones.phiOff, hs.zones.buffer, hs.relabelEvery, hs.diluteSteps);
     out << fmt::format("events     cell edge {:.4g} m ({})\n", eng.edm().cellSize(),
                        sc.edm.cellSize ? "[edm] cell_size, at least one diameter plus the skin"
                                        : "from the event-driven particles' density, docs/haet.md");
-    out << fmt::format("collapse   modified EDM: dt_min = {:.4g} s (a collision sooner hands both particles to the TDM)\n",
-                       eng.dtMin());
+    out << fmt::format(
+        "collapse   modified EDM: dt_min = {:.4g} s (a collision sooner hands both particles to the TDM)\n",
+        eng.dtMin());
     for (std::size_t a = 0; a < sc.materials.size(); ++a)
-        out << fmt::format("material   {}: restitution {:.5f} in both engines (the soft law's, incl. contact-end rule)\n",
-                           sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+        out << fmt::format(
+            "material   {}: restitution {:.5f} in both engines (the soft law's, incl. contact-end rule)\n",
+            sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
 }
 
 void describeScenario(const Scenario& sc, std::ostream& out) {

@@ -52,20 +52,20 @@ private:
 };
 
 struct DomainDef {
-    Vec3d lo{0, 0, 0};                      ///< lower corner [m]
-    Vec3d hi{1, 1, 1};                      ///< upper corner [m]
+    Vec3d lo{0, 0, 0};                                  ///< lower corner [m]
+    Vec3d hi{1, 1, 1};                                  ///< upper corner [m]
     std::array<bool, 3> periodic{false, false, false};  ///< periodic per axis
-    Vec3d gravity{0, 0, 0};                 ///< [m/s^2]
+    Vec3d gravity{0, 0, 0};                             ///< [m/s^2]
 };
 
 struct MaterialDef {
     std::string name;
-    double density = 2500;        ///< [kg/m^3] (2D: [kg/m^2], areal)
-    double young = 1e7;           ///< Young's modulus [Pa] (2D: stiffness per length [N/m]); Hertz only
-    double poisson = 0.3;         ///< Poisson ratio [-]; Hertz only
-    double restitution = 0.9;     ///< normal coefficient of restitution e [-], 0 < e <= 1
-    double friction = 0.5;        ///< Coulomb friction coefficient mu [-]
-    double tangentialRestitution = 1.0;  ///< beta0 of Walton's rule (event-driven engine) [-], -1..1
+    double density = 2500;                  ///< [kg/m^3] (2D: [kg/m^2], areal)
+    double young = 1e7;                     ///< Young's modulus [Pa] (2D: stiffness per length [N/m]); Hertz only
+    double poisson = 0.3;                   ///< Poisson ratio [-]; Hertz only
+    double restitution = 0.9;               ///< normal coefficient of restitution e [-], 0 < e <= 1
+    double friction = 0.5;                  ///< Coulomb friction coefficient mu [-]
+    double tangentialRestitution = 1.0;     ///< beta0 of Walton's rule (event-driven engine) [-], -1..1
     std::optional<double> dissipationTime;  ///< viscoelastic Hertz A* [s]; default: from e at impact_velocity
     SourcePos pos;
 };
@@ -78,11 +78,11 @@ struct ContactDef {
     std::optional<double> gammaN;  ///< normal damping, LAMMPS convention F = -m_eff gamma_n v_n [1/s]
     HertzDamping hertzDamping = HertzDamping::Viscoelastic;
     TangentialLaw tangential = TangentialLaw::Spring;
-    std::optional<double> kt;      ///< tangential stiffness [N/m]; default kt_ratio * kn
+    std::optional<double> kt;       ///< tangential stiffness [N/m]; default kt_ratio * kn
     std::optional<double> ktRatio;  ///< kt/kn [-]; default q/(1+q): 2/7 spheres, 1/3 disks
-    double gammaT = 0;             ///< tangential damping, LAMMPS convention [1/s]
-    bool attraction = false;       ///< false: normal force clipped at zero (no attraction while separating)
-    double impactVelocity = 1.0;   ///< Hertz: impact speed used for t_c and the time-step rule [m/s]
+    double gammaT = 0;              ///< tangential damping, LAMMPS convention [1/s]
+    bool attraction = false;        ///< false: normal force clipped at zero (no attraction while separating)
+    double impactVelocity = 1.0;    ///< Hertz: impact speed used for t_c and the time-step rule [m/s]
     /// Polygon contacts: dimensionless normal damping gamma of PHYSICS.md G.3; default from the restitution
     std::optional<double> polygonDamping;
     /// Polygon contacts: F = Y A / l at the overlap centroid (G.3), or the energy-conserving F = Y A |c| / L^2
@@ -107,67 +107,67 @@ enum class EdmTangential { Walton, Constant };
 struct EdmDef {
     /// Tangential restitution: Walton's rule with (e, mu, beta0) of the materials, or beta = beta0 always.
     EdmTangential tangential = EdmTangential::Walton;
-    bool tcModel = true;              ///< inelastic-collapse protection (TC model, PHYSICS.md D.7)
-    std::optional<double> tcTime;     ///< TC time [s]; default: the soft contact duration t_c
-    std::optional<double> cellSize;   ///< event grid cell edge [m]; default: the largest diameter
+    bool tcModel = true;             ///< inelastic-collapse protection (TC model, PHYSICS.md D.7)
+    std::optional<double> tcTime;    ///< TC time [s]; default: the soft contact duration t_c
+    std::optional<double> cellSize;  ///< event grid cell edge [m]; default: the largest diameter
     SourcePos pos;
 };
 
 /// The hybrid (method = "haet"), PHYSICS.md A: TDM where the local volume fraction is high, EDM where low.
 struct HaetDef {
-    std::optional<double> zoneSize;   ///< zone cell edge [m]; default 4 x the largest diameter
-    std::optional<double> phiOn;      ///< a zone turns dense above this volume (area) fraction [-]
-    std::optional<double> phiOff;     ///< and dilute again below this one [-]; phi_off < phi_on
-    int relabelEvery = 50;            ///< zone re-labelling and mode-change period [TDM steps]
-    int buffer = 1;                   ///< zones around a dense zone whose particles are TDM too [cells]
-    int diluteSteps = 20;             ///< a TDM particle returns to EDM after its zone is dilute this long [steps]
-    std::optional<double> dtMin;      ///< modified EDM: minimum time between collisions [s]; default t_c
+    std::optional<double> zoneSize;  ///< zone cell edge [m]; default 4 x the largest diameter
+    std::optional<double> phiOn;     ///< a zone turns dense above this volume (area) fraction [-]
+    std::optional<double> phiOff;    ///< and dilute again below this one [-]; phi_off < phi_on
+    int relabelEvery = 50;           ///< zone re-labelling and mode-change period [TDM steps]
+    int buffer = 1;                  ///< zones around a dense zone whose particles are TDM too [cells]
+    int diluteSteps = 20;            ///< a TDM particle returns to EDM after its zone is dilute this long [steps]
+    std::optional<double> dtMin;     ///< modified EDM: minimum time between collisions [s]; default t_c
     SourcePos pos;
 };
 
 struct WallDef {
-    Vec3d point{0, 0, 0};    ///< a point on the plane [m]
-    Vec3d normal{0, 0, 1};   ///< unit normal pointing into the domain (normalised by the loader)
-    Vec3d velocity{0, 0, 0}; ///< translation velocity of the plane [m/s]
-    int material = 0;        ///< index into Scenario::materials
+    Vec3d point{0, 0, 0};     ///< a point on the plane [m]
+    Vec3d normal{0, 0, 1};    ///< unit normal pointing into the domain (normalised by the loader)
+    Vec3d velocity{0, 0, 0};  ///< translation velocity of the plane [m/s]
+    int material = 0;         ///< index into Scenario::materials
     SourcePos pos;
 };
 
 struct InsertDef {
     Arrangement arrangement = Arrangement::Random;
-    std::size_t count = 0;             ///< number of particles (lattice: at most this many)
+    std::size_t count = 0;                ///< number of particles (lattice: at most this many)
     double radiusMin = 0, radiusMax = 0;  ///< radius range [m], uniform; equal for monodisperse
     int material = 0;
     Vec3d regionLo{0, 0, 0}, regionHi{0, 0, 0};  ///< box the centres+radii must fit in [m]
-    std::optional<double> spacing;     ///< lattice spacing [m]; default 2 * radius_max
-    Vec3d velocity{0, 0, 0};           ///< mean velocity [m/s]
-    double temperature = 0;            ///< velocity variance per component [m^2/s^2] (Maxwellian)
+    std::optional<double> spacing;               ///< lattice spacing [m]; default 2 * radius_max
+    Vec3d velocity{0, 0, 0};                     ///< mean velocity [m/s]
+    double temperature = 0;                      ///< velocity variance per component [m^2/s^2] (Maxwellian)
     bool frozen = false;
-    std::string file;                  ///< arrangement = File: path (resolved against the scenario dir)
+    std::string file;  ///< arrangement = File: path (resolved against the scenario dir)
     FileFormat format = FileFormat::Csv;
-    std::vector<int> frozenTypes;      ///< LAMMPS data files: atom types (1-based) whose particles are frozen
+    std::vector<int> frozenTypes;  ///< LAMMPS data files: atom types (1-based) whose particles are frozen
     // Polygons (2D, PHYSICS.md G). `radius` is then the circumradius about the centroid (the bounding circle).
     ShapeKind shape = ShapeKind::Disk;
     PolygonKind polygon = PolygonKind::Regular;
-    int sidesMin = 0, sidesMax = 0;    ///< vertices per polygon, uniform in [min, max] (regular: min = max)
-    double aspect = 1;                 ///< rectangle: side ratio (x over y) [-]; random: largest stretch [-]
-    std::optional<double> orientation; ///< [rad]; unset = uniform random in [0, 2 pi)
+    int sidesMin = 0, sidesMax = 0;     ///< vertices per polygon, uniform in [min, max] (regular: min = max)
+    double aspect = 1;                  ///< rectangle: side ratio (x over y) [-]; random: largest stretch [-]
+    std::optional<double> orientation;  ///< [rad]; unset = uniform random in [0, 2 pi)
     SourcePos pos;
 };
 
 struct OutputDef {
-    std::string directory = "out";    ///< run directory (--out overrides)
-    double seriesPeriod = 0;          ///< [s] between rows of series.csv; 0 = 1/100 of duration
-    double snapshotPeriod = 0;        ///< [s] between snapshots; 0 = 1/20 of duration; < 0 = none
+    std::string directory = "out";  ///< run directory (--out overrides)
+    double seriesPeriod = 0;        ///< [s] between rows of series.csv; 0 = 1/100 of duration
+    double snapshotPeriod = 0;      ///< [s] between snapshots; 0 = 1/20 of duration; < 0 = none
     SourcePos pos;
 };
 
 struct Scenario {
-    std::string path;        ///< scenario file
+    std::string path;  ///< scenario file
     std::string name;
     int dimension = 3;
     Method method = Method::Tdm;
-    double duration = 0;     ///< simulated time [s]
+    double duration = 0;  ///< simulated time [s]
     std::uint64_t seed = 1;
     DomainDef domain;
     std::vector<MaterialDef> materials;
@@ -178,7 +178,7 @@ struct Scenario {
     std::vector<WallDef> walls;
     std::vector<InsertDef> inserts;
     OutputDef output;
-    std::string hash;        ///< hash of the file contents (hex)
+    std::string hash;  ///< hash of the file contents (hex)
 };
 
 }  // namespace haet

@@ -1,26 +1,25 @@
 #include "scenario/insert.hpp"
-#include "scenario/text.hpp"
-
-#include "polygon/geometry.hpp"
 
 #include <algorithm>
-#include <functional>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
 
+#include "polygon/geometry.hpp"
+#include "scenario/text.hpp"
+
 namespace haet {
 namespace {
 
 std::string insertKey(std::size_t k) { return "insert[" + std::to_string(k + 1) + "]"; }
-
 
 std::string_view trim(std::string_view s) {
     const auto first = s.find_first_not_of(" \t\r\n");
@@ -208,8 +207,8 @@ struct NewParticle {
     std::uint16_t material = 0;
     std::uint8_t flags = 0;
     std::array<std::int32_t, D> image{};  ///< periodic box crossings (Particles::image)
-    std::vector<Vec<2>> body;  ///< polygon vertices in the body frame [m]; empty for a disk or sphere
-    double orientation = 0;    ///< polygon angle [rad]
+    std::vector<Vec<2>> body;             ///< polygon vertices in the body frame [m]; empty for a disk or sphere
+    double orientation = 0;               ///< polygon angle [rad]
 
     double mass() const {
         if (body.empty()) return density * Particles<D>::volumeOf(radius);
@@ -225,9 +224,15 @@ void makePolygon(const InsertDef& in, NewParticle<D>& p, Rng& rng) {
     const int sides = in.sidesMin + int(rng.uniform() * (in.sidesMax - in.sidesMin + 1));
     p.orientation = in.orientation ? *in.orientation : rng.uniform(0, twoPi);
     switch (in.polygon) {
-        case PolygonKind::Regular: p.body = polygon::regularPolygon(sides, p.radius, 0.0); break;
-        case PolygonKind::Rectangle: p.body = polygon::rectangle(in.aspect, p.radius, 0.0); break;
-        case PolygonKind::Random: p.body = polygon::randomConvexPolygon(rng, sides, p.radius, in.aspect, 0.0); break;
+        case PolygonKind::Regular:
+            p.body = polygon::regularPolygon(sides, p.radius, 0.0);
+            break;
+        case PolygonKind::Rectangle:
+            p.body = polygon::rectangle(in.aspect, p.radius, 0.0);
+            break;
+        case PolygonKind::Random:
+            p.body = polygon::randomConvexPolygon(rng, sides, p.radius, in.aspect, 0.0);
+            break;
     }
 }
 

@@ -41,7 +41,7 @@ struct FilePolygon {
     double w = 0;                  ///< angular velocity [rad/s]
     int material = -1;             ///< index into Scenario::materials; -1: the insert's material
     bool frozen = false;
-    int line = 0;                  ///< line of the file, for messages
+    int line = 0;  ///< line of the file, for messages
 };
 
 /// Reads a polygon CSV file (insert with shape = "polygon", arrangement = "file"): a header naming the columns

@@ -1,5 +1,6 @@
 #include "scenario/loader.hpp"
-#include "scenario/text.hpp"
+
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,13 +13,12 @@
 #include <utility>
 #include <vector>
 
-#include <toml++/toml.h>
+#include "scenario/text.hpp"
 
 namespace haet {
 namespace {
 
 const char* const kAxisName[3] = {"x", "y", "z"};
-
 
 /// Reads the values of one TOML table and knows the dotted key path of each, so that every error names the key
 /// and the line it came from (the value's line, or the table's when the key is missing).
@@ -418,8 +418,8 @@ private:
         r.allowOnly({"tangential", "tc_model", "tc_time", "cell_size"});
         EdmDef& e = s.edm;
         e.pos = r.tablePos();
-        e.tangential = r.choice<EdmTangential>("tangential", {{"walton", EdmTangential::Walton},
-                                                              {"constant", EdmTangential::Constant}})
+        e.tangential = r.choice<EdmTangential>(
+                            "tangential", {{"walton", EdmTangential::Walton}, {"constant", EdmTangential::Constant}})
                            .value_or(EdmTangential::Walton);
         e.tcModel = r.boolean("tc_model").value_or(true);
         e.tcTime = r.number("tc_time");
@@ -488,8 +488,7 @@ private:
 
     InsertDef readInsert(const TableReader& r) const {
         r.allowOnly({"arrangement", "count", "radius", "material", "region", "spacing", "velocity", "temperature",
-                     "frozen", "file", "format", "frozen_types", "shape", "polygon", "sides", "aspect",
-                     "orientation"});
+                     "frozen", "file", "format", "frozen_types", "shape", "polygon", "sides", "aspect", "orientation"});
         InsertDef in;
         in.pos = r.tablePos();
         in.arrangement = r.choice<Arrangement>("arrangement", {{"random", Arrangement::Random},
@@ -591,9 +590,9 @@ private:
             in.sidesMax = int(hi->get());
         } else {
             const auto sides = r.integer("sides");
-            if (!sides) r.fail("sides", "is required for polygon = \"" +
-                                            std::string(in.polygon == PolygonKind::Regular ? "regular" : "random") +
-                                            "\"");
+            if (!sides)
+                r.fail("sides", "is required for polygon = \"" +
+                                    std::string(in.polygon == PolygonKind::Regular ? "regular" : "random") + "\"");
             if (*sides < 3 || *sides > maxSides) r.fail("sides", sidesRange);
             in.sidesMin = in.sidesMax = int(*sides);
         }

@@ -41,22 +41,20 @@ void TdmEngine<D>::computeForces(bool correct, std::atomic<bool>* nextMoved) {
         using T = decltype(tangential);
         if constexpr (D == 2) {
             if (poly_) {  // polygons present: their loop (polygon/forces.hpp) also serves the disks among them
-                stats_ = polygon::computePolygonForces<N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs,
-                                                             w_.domain, w_.time, s_.dt, motion_.v.data(),
-                                                             motion_.w.data(), *poly_);
+                stats_ =
+                    polygon::computePolygonForces<N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain,
+                                                        w_.time, s_.dt, motion_.v.data(), motion_.w.data(), *poly_);
                 return;
             }
         }
         auto forces = [&](auto then) {
-            stats_ = haet::computeForces<D, N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain,
-                                                  w_.time, s_.dt, motion_.v.data(), motion_.w.data(), scratch_,
-                                                  then);
+            stats_ = haet::computeForces<D, N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain, w_.time,
+                                                  s_.dt, motion_.v.data(), motion_.w.data(), scratch_, then);
         };
         // Verlet's corrector needs nothing but the particle's own new force: it runs inside the force pass, and
         // so does the next step's predictor when that step follows at once (advanceTo).
         if (correct && verlet_ && nextMoved) {
-            forces(verlet_->correctPredict(w_.particles, s_.dt, motion_, xAtBuild_.data(), driftLimit2(),
-                                           nextMoved));
+            forces(verlet_->correctPredict(w_.particles, s_.dt, motion_, xAtBuild_.data(), driftLimit2(), nextMoved));
             corrected = true;
         } else if (correct && verlet_) {
             forces(verlet_->corrector(w_.particles, s_.dt, motion_));
@@ -186,8 +184,7 @@ template <int D>
 void TdmEngine<D>::finishStep(bool moved, std::atomic<bool>* nextMoved) {
     w_.time += s_.dt;
     ++steps_;
-    if (moved)
-        rebuild(s_.sortEvery > 0 && steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery));
+    if (moved) rebuild(s_.sortEvery > 0 && steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery));
     computeForces(true, nextMoved);
     checkHealth();
 }

@@ -21,10 +21,10 @@ struct PolygonScratch;
 
 struct TdmSettings {
     IntegratorKind integrator = IntegratorKind::Verlet;
-    double dt = 0;             ///< [s]
-    double skin = 0;           ///< [m]
-    double maxOverlap = 0.5;   ///< blow-up limit: overlap / smaller radius [-]
-    int sortEvery = 1000;      ///< spatial re-sort period in steps (0 = never)
+    double dt = 0;            ///< [s]
+    double skin = 0;          ///< [m]
+    double maxOverlap = 0.5;  ///< blow-up limit: overlap / smaller radius [-]
+    int sortEvery = 1000;     ///< spatial re-sort period in steps (0 = never)
 };
 
 template <int D>

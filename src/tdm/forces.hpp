@@ -14,12 +14,12 @@
 // (in pair order: they all precede the range's own pairs), and takes its own cross pairs from their slots in
 // their place among its pairs. Same additions in the same order as with one thread, so the same bits. After a
 // spatial sort the ranges are slabs of space and the cross pairs lie along their faces: a few per cent.
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
-
-#include <omp.h>
 
 #include "contact/laws.hpp"
 #include "contact/setup.hpp"
@@ -33,11 +33,11 @@ namespace haet {
 
 struct ForceStats {
     static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-    std::size_t contacts = 0;        ///< pair and wall contacts
-    double maxOverlapRatio = 0;      ///< largest overlap / smaller radius
-    std::size_t worstParticle = 0;   ///< particle with that overlap
-    double virial = 0;               ///< sum over pair contacts of r_ij . F_ij, summed particle by particle [J]
-    std::size_t nonFinite = kNone;   ///< first particle with a non-finite position or force, or kNone
+    std::size_t contacts = 0;       ///< pair and wall contacts
+    double maxOverlapRatio = 0;     ///< largest overlap / smaller radius
+    std::size_t worstParticle = 0;  ///< particle with that overlap
+    double virial = 0;              ///< sum over pair contacts of r_ij . F_ij, summed particle by particle [J]
+    std::size_t nonFinite = kNone;  ///< first particle with a non-finite position or force, or kNone
 };
 
 /// What forceRange reports of its particles: ForceStats without the virial, which is summed per particle.
@@ -62,10 +62,10 @@ inline void addTally(ForceStats& st, const RangeTally& t) {
 /// run (threaded path), or an entry of a PairBlock.
 template <int D>
 struct CrossPair {
-    Vec<D> f;         ///< force on i [N]
-    Ang<D> nxft;      ///< n x F_t [N]
-    double virial;    ///< r_ij . F_ij [N m]
-    double overlap;   ///< overlap / smaller radius
+    Vec<D> f;        ///< force on i [N]
+    Ang<D> nxft;     ///< n x F_t [N]
+    double virial;   ///< r_ij . F_ij [N m]
+    double overlap;  ///< overlap / smaller radius
     bool touching;
 };
 
@@ -74,8 +74,8 @@ struct CrossPair {
 /// alone has more), so its buffers stay in L1.
 template <int D>
 struct PairBlock {
-    static constexpr std::uint32_t kPairs = 128;   ///< listed pairs per block
-    static constexpr std::uint32_t kOwners = 64;   ///< particles per block
+    static constexpr std::uint32_t kPairs = 128;              ///< listed pairs per block
+    static constexpr std::uint32_t kOwners = 64;              ///< particles per block
     static constexpr std::uint32_t kNoPartner = 0xFFFFFFFFu;  ///< an entry taken from a cross pair's slot
     static constexpr std::uint32_t kNoOwner = 0xFFFFFFFFu;    ///< past the last touching pair
     /// Four doubles (a vector, zero-padded): the rows of four pairs are transposed into lanes and back.
@@ -100,7 +100,7 @@ struct PairBlock {
     /// Blocks with cross pairs: the block's particle b0 + q has entries [ownerEnd[q-1], ownerEnd[q]). Other blocks
     /// find a particle's touching pairs by their owner: owner[nl] = kNoOwner ends the list.
     std::vector<std::uint32_t> ownerEnd;
-    std::size_t reach = 0;                  ///< 1 + the largest partner of the block's pairs (cross pairs aside)
+    std::size_t reach = 0;  ///< 1 + the largest partner of the block's pairs (cross pairs aside)
 
     /// Room for a block of `pairs` listed pairs.
     void fit(std::size_t pairs) {
@@ -121,9 +121,9 @@ struct PairBlock {
 template <int D>
 struct ForceScratch {
     std::vector<PairBlock<D>> blocks;  ///< one per thread (forceRange)
-    std::vector<CrossPair<D>> cross;  ///< the disk loop's cross pairs (PairList::split)
-    std::vector<double> virial;       ///< per particle: sum over own pairs of r_ij . F_ij [N m]
-    std::vector<RangeTally> tally;    ///< the disk loop's per-range statistics
+    std::vector<CrossPair<D>> cross;   ///< the disk loop's cross pairs (PairList::split)
+    std::vector<double> virial;        ///< per particle: sum over own pairs of r_ij . F_ij [N m]
+    std::vector<RangeTally> tally;     ///< the disk loop's per-range statistics
 };
 
 /// Force of one pair: F on i (on j: -F) and n x F_t (torque on each: -a (n x F_t)).
@@ -162,12 +162,25 @@ struct PairInputs {
 template <int D>
 PairInputs<D> pairInputs(const Particles<D>& p, PairList<D>& pl, const ContactSetup& cs, const Vec<D>* sv,
                          const Ang<D>* sw, double dt) {
-    return {p.x.data(),        p.v.data(),      p.w.data(),         p.radius.data(),
-            p.invMass.data(),  p.material.data(), sv,               sw,
-            pl.partner.data(), static_cast<std::uint32_t>(pl.partner.size()),
-            pl.owner.data(),   pl.shift.data(), pl.shiftVec.data(), pl.history.data(),
-            cs.table.data(),   cs.nMaterials,   uniformForceLaw(cs.table.data(), cs.table.size()),
-            !cs.attraction,    dt};
+    return {p.x.data(),
+            p.v.data(),
+            p.w.data(),
+            p.radius.data(),
+            p.invMass.data(),
+            p.material.data(),
+            sv,
+            sw,
+            pl.partner.data(),
+            static_cast<std::uint32_t>(pl.partner.size()),
+            pl.owner.data(),
+            pl.shift.data(),
+            pl.shiftVec.data(),
+            pl.history.data(),
+            cs.table.data(),
+            cs.nMaterials,
+            uniformForceLaw(cs.table.data(), cs.table.size()),
+            !cs.attraction,
+            dt};
 }
 
 /// Particle i's own data, loaded once for all its pairs.
@@ -179,8 +192,13 @@ struct Owner {
     const PairCoeffs* coeffRow;  ///< row of i's material in the coefficient table
 
     Owner(const PairInputs<D>& in, std::size_t i)
-        : x(kernelVec(in.x[i])), v(kernelVec(in.v[i])), sv(kernelVec(in.sv[i])), w(kernelVec(in.w[i])),
-          sw(kernelVec(in.sw[i])), radius(in.radius[i]), invMass(in.invMass[i]),
+        : x(kernelVec(in.x[i])),
+          v(kernelVec(in.v[i])),
+          sv(kernelVec(in.sv[i])),
+          w(kernelVec(in.w[i])),
+          sw(kernelVec(in.sw[i])),
+          radius(in.radius[i]),
+          invMass(in.invMass[i]),
           coeffRow(in.table + in.material[i] * in.nMaterials) {}
 };
 
@@ -267,9 +285,9 @@ template <int D, class Normal, class Tangential>
 
 /// What finishParticle reports of one particle.
 struct ParticleTally {
-    double worst;       ///< largest overlap / smaller radius, pairs and walls
+    double worst;            ///< largest overlap / smaller radius, pairs and walls
     std::uint32_t contacts;  ///< own pairs and walls in contact
-    bool finite;        ///< position and force finite
+    bool finite;             ///< position and force finite
 };
 
 /// Whether every component of v is finite (inf - inf and NaN - NaN are NaN, anything else minus itself is 0).
@@ -293,11 +311,10 @@ inline bool allFinite(const Wide3& v) {
 /// stores force and torque -r_i (sum) + wall torques, then runs the caller's per-particle step then(i, f, torque).
 template <int D, class Normal, class Tangential, class Then>
 [[gnu::always_inline]] inline ParticleTally finishParticle(Particles<D>& p, const PairInputs<D>& in,
-                                                          const Wall<D>* walls, std::size_t nw,
-                                                          Vec<D>* wallHistory, const ContactSetup& cs,
-                                                          double time, std::size_t i, KernelVec<D> fk,
-                                                          const KernelVec<kAngDim<D>>& nx, double worst,
-                                                          std::uint32_t contacts, Then& then) {
+                                                           const Wall<D>* walls, std::size_t nw, Vec<D>* wallHistory,
+                                                           const ContactSetup& cs, double time, std::size_t i,
+                                                           KernelVec<D> fk, const KernelVec<kAngDim<D>>& nx,
+                                                           double worst, std::uint32_t contacts, Then& then) {
     const double ri = in.radius[i];
     const KernelVec<D> xi = kernelVec(in.x[i]);
     const KernelVec<kAngDim<D>> tqk = nx * (-ri);
@@ -412,8 +429,8 @@ template <int D, class Tangential>
 /// Returns the number of touching pairs. The twin of findTouchingLanes, and the threaded path's.
 template <int D, class Tangential, bool kCross>
 [[gnu::noinline]] std::uint32_t findTouching(const PairInputs<D>& in, const std::uint32_t* first, std::size_t b0,
-                                             std::size_t b1, std::size_t e, const CrossPair<D>* cross,
-                                             std::size_t& c, PairBlock<D>& bl) {
+                                             std::size_t b1, std::size_t e, const CrossPair<D>* cross, std::size_t& c,
+                                             PairBlock<D>& bl) {
     using Block = PairBlock<D>;
     const std::uint32_t* partner = in.partner;
     std::uint32_t* entry = bl.entry.data();
@@ -479,8 +496,8 @@ inline constexpr CompactTables kCompact{};
 /// population; the springs of the pairs not touching are cleared by the mask. The last listed pairs (fewer than
 /// four) go one pair at a time (testPair). Same list as findTouching.
 template <int D, class Tangential>
-[[gnu::noinline]] std::uint32_t findTouchingLanes(const PairInputs<D>& in, const std::uint32_t* first,
-                                                  std::size_t b0, std::size_t b1, PairBlock<D>& bl) {
+[[gnu::noinline]] std::uint32_t findTouchingLanes(const PairInputs<D>& in, const std::uint32_t* first, std::size_t b0,
+                                                  std::size_t b1, PairBlock<D>& bl) {
     const std::uint32_t k0 = first[b0], n = first[b1] - k0;
     const std::uint32_t* own = in.owner + k0;
     const std::uint32_t* partner = in.partner;
@@ -531,8 +548,8 @@ template <int D, class Tangential>
             // Pairs across a periodic boundary: their shift added (as testPair does), the others' d kept.
             const __m128i code = _mm_cvtepu8_epi32(_mm_cvtsi32_si128(static_cast<int>(sh)));
             const LaneVec<D> sv = gather(in.shiftVec, reinterpret_cast<LaneIndex>(code));
-            const __m256d none =
-                _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_cmpeq_epi32(code, _mm_set1_epi32(PairList<D>::kNoShift))));
+            const __m256d none = _mm256_castsi256_pd(
+                _mm256_cvtepi32_epi64(_mm_cmpeq_epi32(code, _mm_set1_epi32(PairList<D>::kNoShift))));
             for (int c = 0; c < D; ++c) d[c] = _mm256_blendv_pd(_mm256_add_pd(d[c], sv.c[c].v), d[c], none);
         }
         __m256d dist2 = _mm256_mul_pd(d[0], d[0]);  // as norm2: ((d0 d0 + d1 d1) + d2 d2)
@@ -595,7 +612,7 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
         Lanes ri, rj, invMi, invMj;
         RelMotion<LaneVec<D>, LaneVec<A>> rel;
     };
-    auto load = [&](std::uint32_t m, Group& g) __attribute__((always_inline)) {
+    auto load = [&](std::uint32_t m, Group & g) __attribute__((always_inline)) {
         const LaneIndex ii = loadIndex(owner + m), jj = loadIndex(partner + m);
         for (int k = 0; k < D; ++k) {
             Lanes::Values v;
@@ -678,9 +695,8 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
             LaneVec<D, L2> f;
             LaneVec<A, L2> nxft;
             L2 vir, overlap;
-            contactLaw<Normal, Tangential>(c, d, norm2(d), L2(g0.ri, g1.ri), L2(g0.rj, g1.rj),
-                                           L2(g0.invMi, g1.invMi), L2(g0.invMj, g1.invMj), rel, xi, in.clip,
-                                           in.dt, f, nxft, vir, overlap);
+            contactLaw<Normal, Tangential>(c, d, norm2(d), L2(g0.ri, g1.ri), L2(g0.rj, g1.rj), L2(g0.invMi, g1.invMi),
+                                           L2(g0.invMj, g1.invMj), rel, xi, in.clip, in.dt, f, nxft, vir, overlap);
             store(m, halfOf(xi, 0), halfOf(f, 0), halfOf(nxft, 0), vir.lo, overlap.lo);
             store(m + 4, halfOf(xi, 1), halfOf(f, 1), halfOf(nxft, 1), vir.hi, overlap.hi);
         }
@@ -729,20 +745,20 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
 /// apart, else into *virialSum (in particle order either way).
 ///
 /// The particles go in blocks of a few dozen, each in three passes: (1) the contact tests, without a branch on
-/// their outcome (findTouchingLanes, four at a time; findTouching); (2) the contact law on the touching pairs, four at a time in lanes (evalTouching),
-/// where their long chains of square roots and divisions overlap instead of waiting one behind the other; (3) in
-/// pair order, as when each pair was evaluated as its owner came, each contribution added to its owner and
-/// subtracted from its partner, and each particle finished. The law reads positions and velocities only, which no
-/// particle of the block or after it has had changed yet (finishing changes a particle's velocity, after its last
-/// pair), so the passes give the same bits as one pair at a time.
+/// their outcome (findTouchingLanes, four at a time; findTouching); (2) the contact law on the touching pairs, four at
+/// a time in lanes (evalTouching), where their long chains of square roots and divisions overlap instead of waiting one
+/// behind the other; (3) in pair order, as when each pair was evaluated as its owner came, each contribution added to
+/// its owner and subtracted from its partner, and each particle finished. The law reads positions and velocities only,
+/// which no particle of the block or after it has had changed yet (finishing changes a particle's velocity, after its
+/// last pair), so the passes give the same bits as one pair at a time.
 template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class Then>
 [[gnu::always_inline]] inline RangeTally forceRange(Particles<D>& p, const PairInputs<D>& in,
-                                                     const std::uint32_t* first, const Wall<D>* walls, std::size_t nw,
-                                                     Vec<D>* wh, const ContactSetup& cs, double time, const Vec<D>& g,
-                                                     std::size_t b, std::size_t e, const CrossPair<D>* cross,
-                                                     std::size_t c0, const std::uint64_t* crossIn,
-                                                     const std::uint64_t* crossInEnd, double* virial,
-                                                     double* virialSum, PairBlock<D>& bl, Then& then) {
+                                                    const std::uint32_t* first, const Wall<D>* walls, std::size_t nw,
+                                                    Vec<D>* wh, const ContactSetup& cs, double time, const Vec<D>& g,
+                                                    std::size_t b, std::size_t e, const CrossPair<D>* cross,
+                                                    std::size_t c0, const std::uint64_t* crossIn,
+                                                    const std::uint64_t* crossInEnd, double* virial, double* virialSum,
+                                                    PairBlock<D>& bl, Then& then) {
     using Block = PairBlock<D>;
     Vec<D>* f = p.f.data();
     Ang<D>* nx = p.torque.data();  // holds the sums of n x F_t until the particle is finished
@@ -780,7 +796,8 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
         auto runBlock = [&]<bool kCrossBlock>() __attribute__((always_inline)) {
             std::uint32_t nl;
 #ifdef __AVX2__
-            if constexpr (kLanes && !kCrossBlock) nl = findTouchingLanes<D, Tangential>(in, first, b0, b1, bl);
+            if constexpr (kLanes && !kCrossBlock)
+                nl = findTouchingLanes<D, Tangential>(in, first, b0, b1, bl);
             else
 #endif
                 nl = findTouching<D, Tangential, kCrossBlock>(in, first, b0, b1, e, cross, c, bl);
@@ -831,11 +848,13 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
                     worst = std::max(worst, x.b.c[3]);
                     ++nc;
                 }
-                const ParticleTally pt = finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, fi,
-                                                                               nxi, worst, nc, then);
+                const ParticleTally pt =
+                    finishParticle<D, Normal, Tangential>(p, in, walls, nw, wh, cs, time, i, fi, nxi, worst, nc, then);
                 st.contacts += pt.contacts;
-                if constexpr (kCross) virial[i] = vir;
-                else virialAcc += vir;
+                if constexpr (kCross)
+                    virial[i] = vir;
+                else
+                    virialAcc += vir;
                 if (pt.worst > st.maxOverlapRatio) {
                     st.maxOverlapRatio = pt.worst;
                     st.worstParticle = i;
@@ -869,9 +888,8 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes, class
 /// hold the two to the same bits.
 template <int D, class Normal, class Tangential, bool kLanes = kLanePairs, class Then>
 ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wall<D>>& walls,
-                         std::vector<Vec<D>>& wallHistory, const ContactSetup& cs, const Domain<D>& dom,
-                         double time, double dt, const Vec<D>* sv, const Ang<D>* sw, ForceScratch<D>& s,
-                         Then then) {
+                         std::vector<Vec<D>>& wallHistory, const ContactSetup& cs, const Domain<D>& dom, double time,
+                         double dt, const Vec<D>* sv, const Ang<D>* sw, ForceScratch<D>& s, Then then) {
     const std::size_t n = p.tdmCount();
     if constexpr (kLanes) pl.makeOwners();
     const PairInputs<D> in = pairInputs(p, pl, cs, sv, sw, dt);
@@ -885,9 +903,9 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
 
     if (s.blocks.size() < static_cast<std::size_t>(nt)) s.blocks.resize(static_cast<std::size_t>(nt));
     if (nt <= 1) {
-        const RangeTally t = forceRange<D, Normal, Tangential, false, kLanes>(p, in, first, wp, nw, wh, cs, time,
-                                                                              g, 0, n, nullptr, 0, nullptr, nullptr,
-                                                                              nullptr, &st.virial, s.blocks[0], then);
+        const RangeTally t =
+            forceRange<D, Normal, Tangential, false, kLanes>(p, in, first, wp, nw, wh, cs, time, g, 0, n, nullptr, 0,
+                                                             nullptr, nullptr, nullptr, &st.virial, s.blocks[0], then);
         addTally(st, t);
         return st;
     }

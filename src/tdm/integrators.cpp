@@ -38,14 +38,25 @@ void VelocityVerlet<D>::start(const Particles<D>&, double) {}
 
 template <int D>
 typename VelocityVerlet<D>::Predictor VelocityVerlet<D>::predictor(Particles<D>& p, double dt, StepMotion<D>& m,
-                                                                  const Vec<D>* ref, double limit2) {
+                                                                   const Vec<D>* ref, double limit2) {
     const std::size_t n = p.tdmCount();
     m.v.resize(n);
     m.w.resize(n);
     Ang<D>* ang = p.angle.empty() ? nullptr : p.angle.data();
-    return {p.x.data(),       p.v.data(),          ang,            p.w.data(), m.v.data(), m.w.data(),
-            p.f.data(),       p.torque.data(),     p.invMass.data(), p.invInertia.data(),
-            p.flags.data(),   ref,                 dt,             limit2};
+    return {p.x.data(),
+            p.v.data(),
+            ang,
+            p.w.data(),
+            m.v.data(),
+            m.w.data(),
+            p.f.data(),
+            p.torque.data(),
+            p.invMass.data(),
+            p.invInertia.data(),
+            p.flags.data(),
+            ref,
+            dt,
+            limit2};
 }
 
 template <int D>
@@ -93,16 +104,16 @@ inline constexpr V4i kSpread = {(4 * R) / W, (4 * R + 1) / W, (4 * R + 2) / W, (
 /// With ref (positions), sq gets the squares of (new position - ref) element by element. Without kPos only the
 /// velocities (the spin of a particle whose orientation is not kept).
 template <int W, bool kAnyFrozen, bool kDrift = false, bool kPos = true>
-[[gnu::always_inline]] inline void correctPredict4(const double* f, double* x, double* v, double* mv, V4 scale,
-                                                    V4i fz, double dt, double h, double h2,
-                                                    const double* ref = nullptr, V4* sq = nullptr) {
+[[gnu::always_inline]] inline void correctPredict4(const double* f, double* x, double* v, double* mv, V4 scale, V4i fz,
+                                                   double dt, double h, double h2, const double* ref = nullptr,
+                                                   V4* sq = nullptr) {
     [&]<int... R>(std::integer_sequence<int, R...>) {
         (
             [&] {
                 const V4 s = __builtin_shuffle(scale, kSpread<W, R>);
                 const V4 mv0 = load4(mv + 4 * R);
                 const V4 a = load4(f + 4 * R) * s;
-                const V4 vi = mv0 + a * splat(h);  // the corrector: v(t + dt)
+                const V4 vi = mv0 + a * splat(h);   // the corrector: v(t + dt)
                 V4 mvn = vi + a * splat(0.5 * dt);  // the predictor of the next step
                 V4 vn = vi + a * splat(dt);
                 if constexpr (kAnyFrozen) {
@@ -125,7 +136,8 @@ template <int W, bool kAnyFrozen, bool kDrift = false, bool kPos = true>
                 store4(mv + 4 * R, mvn);
             }(),
             ...);
-    }(std::make_integer_sequence<int, W>{});
+    }
+    (std::make_integer_sequence<int, W>{});
 }
 
 /// The squared lengths of four particles' D-vectors from the squares of their components (in D registers, the
@@ -158,8 +170,8 @@ void VelocityVerlet<D>::CorrectPredict::finishBlock(std::size_t b, std::size_t e
         auto four = [&]<bool kAnyFrozen>(V4i fz) {
             V4 sq[D];
             correctPredict4<D, kAnyFrozen, true>(pr.f[i].c.data(), pr.x[i].c.data(), pr.v[i].c.data(),
-                                                 pr.mv[i].c.data(), load4(correct.invMass + i), fz, dt, correct.h,
-                                                 h2, pr.ref[i].c.data(), sq);
+                                                 pr.mv[i].c.data(), load4(correct.invMass + i), fz, dt, correct.h, h2,
+                                                 pr.ref[i].c.data(), sq);
             correctPredict4<A, kAnyFrozen, false, kAng>(pr.torque[i].c.data(), kAng ? pr.ang[i].c.data() : nullptr,
                                                         pr.w[i].c.data(), pr.mw[i].c.data(),
                                                         load4(correct.invInertia + i), fz, dt, correct.h, h2);
@@ -178,8 +190,10 @@ void VelocityVerlet<D>::CorrectPredict::finishBlock(std::size_t b, std::size_t e
             }
         }
     };
-    if (pr.ang) fours.template operator()<true>();
-    else fours.template operator()<false>();
+    if (pr.ang)
+        fours.template operator()<true>();
+    else
+        fours.template operator()<false>();
     for (; i < e; ++i) {
         correct(i, pr.f[i], pr.torque[i]);
         far |= pr(i);

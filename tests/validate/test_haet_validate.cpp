@@ -17,9 +17,9 @@
 namespace haet {
 namespace {
 
-constexpr int kSamples = 15;        // every 0.02 s up to 0.3 s
-constexpr double kEvery = 0.02;     // [s]
-constexpr double kRestSpeed = 0.05; // [m/s]: a grain slower than this has landed
+constexpr int kSamples = 15;         // every 0.02 s up to 0.3 s
+constexpr double kEvery = 0.02;      // [s]
+constexpr double kRestSpeed = 0.05;  // [m/s]: a grain slower than this has landed
 
 std::string scene(int seed) {
     return "name = 'rain'\ndimension = 2\nduration = 0.3\nseed = " + std::to_string(seed) +

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "../physics_util.hpp"
 #include "scenario/loader.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
-#include "../physics_util.hpp"
 
 namespace haet {
 namespace {

@@ -11,11 +11,11 @@
 #include <filesystem>
 #include <string>
 
+#include "../physics_util.hpp"
+#include "../polygon_util.hpp"
 #include "scenario/loader.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
-#include "../physics_util.hpp"
-#include "../polygon_util.hpp"
 
 namespace haet {
 namespace {
@@ -65,8 +65,7 @@ TEST(PolygonEnergyLong, OverlapAreaLawEnergyChangeShrinksWithStiffness) {
             const double dE = testing::collisionEnergyChange(seed, 1.0 / 8, PolygonLaw::OverlapArea, young);
             mean += std::abs(dE) / n;
             worst = std::max(worst, std::abs(dE));
-            meanPotential +=
-                std::abs(testing::collisionEnergyChange(seed, 1.0 / 8, PolygonLaw::Potential, young)) / n;
+            meanPotential += std::abs(testing::collisionEnergyChange(seed, 1.0 / 8, PolygonLaw::Potential, young)) / n;
         }
         const std::string y = std::to_string(int(std::log10(young) + 0.5));
         record("mean_energy_change_Y1e" + y, mean);
