@@ -74,7 +74,7 @@ haet::World<2> packing(const haet::Scenario& sc, bool polygons) {
             else
                 w.particles.add(x, haet::Vec<2>::zero(), haet::Ang<2>::zero(), 0.5 * width, 2.0, 0, id);
         }
-    w.contact = haet::buildContactSetup(sc, haet::materialStats(w.particles, 1));
+    w.contact = haet::buildContactSetup<2>(sc, haet::materialStats(w.particles, 1));
     return w;
 }
 

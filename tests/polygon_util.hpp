@@ -36,7 +36,7 @@ inline double collisionEnergyChange(std::uint64_t seed, double dtFactor, Polygon
     w.particles.addPolygon(Vec<2>{{-1.05 * R, 0}}, Vec<2>{{0.1, 0}}, Ang<2>{{spin}}, rng.uniform(0, 6.3), a, 2.0, 0, 0);
     w.particles.addPolygon(Vec<2>{{1.05 * R, off}}, Vec<2>{{-0.1, 0}}, Ang<2>::zero(), rng.uniform(0, 6.3), b, 2.0, 0,
                            1);
-    w.contact = buildContactSetup(sc, materialStats(w.particles, 1));
+    w.contact = buildContactSetup<2>(sc, materialStats(w.particles, 1));
     TdmSettings s;
     s.integrator = IntegratorKind::Gear5;
     s.dt = w.contact.polygonStep * dtFactor;

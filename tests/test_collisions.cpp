@@ -52,7 +52,7 @@ Collision<D> collide(double e, IntegratorKind integ, bool wall, double gtOverGn,
         w.particles.add(n * (a + 0.5 * gap), v0 * 0.5, Ang<D>::zero(), a, 1000, 0, 0);
         w.particles.add(n * (-a - 0.5 * gap), v0 * -0.5, Ang<D>::zero(), a, 1000, 0, 1);
     }
-    w.contact = buildContactSetup(sc, testing::statsOf(w.particles, 1));
+    w.contact = buildContactSetup<D>(sc, testing::statsOf(w.particles, 1));
     TdmSettings s;
     s.integrator = integ;
     s.dt = tc / 50;

@@ -45,7 +45,7 @@ World<D> collisionWorld(bool wall, double ratio, double phase) {
         w.particles.add(n * (kA + 0.5 * gap), v0 * 0.5, Ang<D>::zero(), kA, 1000, 0, 0);
         w.particles.add(n * (-kA - 0.5 * gap), v0 * -0.5, Ang<D>::zero(), kA, 1000, 0, 1);
     }
-    w.contact = buildContactSetup(sc, testing::statsOf(w.particles, 1));
+    w.contact = buildContactSetup<D>(sc, testing::statsOf(w.particles, 1));
     return w;
 }
 

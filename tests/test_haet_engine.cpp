@@ -41,7 +41,7 @@ World<D> pairWorld(double ratio) {
     const Vec<D> v0 = n * (-kVn) + t * (ratio * kVn);
     w.particles.add(n * (kA + 0.5 * gap), v0 * 0.5, Ang<D>::zero(), kA, 1000, 0, 0);
     w.particles.add(n * (-kA - 0.5 * gap), v0 * -0.5, Ang<D>::zero(), kA, 1000, 0, 1);
-    w.contact = buildContactSetup(sc, testing::statsOf(w.particles, 1));
+    w.contact = buildContactSetup<D>(sc, testing::statsOf(w.particles, 1));
     return w;
 }
 

@@ -165,7 +165,7 @@ InclineResult incline(double thetaDeg, double mu, TangentialLaw tang, Integrator
     const double delta0 = g * std::cos(theta) / kOverM;
     w.particles.add(n * (a - delta0), Vec<D>::zero(), Ang<D>::zero(), a, rho, 0, 0);
     w.walls.push_back(Wall<D>{Vec<D>::zero(), n, Vec<D>::zero(), 0});
-    w.contact = buildContactSetup(sc, testing::statsOf(w.particles, 1));
+    w.contact = buildContactSetup<D>(sc, testing::statsOf(w.particles, 1));
     TdmSettings s;
     s.integrator = integ;
     s.dt = tc / 50;
@@ -317,7 +317,7 @@ HeadOnMeasure hertzHeadOn(const Scenario& sc, const HertzMaterial& hm, double v,
     };
     // The set-up sizes t_c from the particles; the positions do not matter for it.
     place(0);
-    w.contact = buildContactSetup(sc, testing::statsOf(w.particles, 1));
+    w.contact = buildContactSetup<3>(sc, testing::statsOf(w.particles, 1));
     s.dt = w.contact.contactTime / stepsPerContact;
     w.particles = Particles<3>{};
     w.walls.clear();

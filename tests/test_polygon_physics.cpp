@@ -60,7 +60,7 @@ FloorScene blockOnFloor(std::vector<V2> body, double thetaDeg, double mu, double
     const double delta = 4 * mg * h / (kYoung * b + 2 * mg);
     f.w.particles.x[0] = V2{{0, h - delta}};
     f.w.walls.push_back(Wall<2>{V2::zero(), V2{{0, 1}}, V2::zero(), 0});
-    f.w.contact = buildContactSetup(sc, materialStats(f.w.particles, 1));
+    f.w.contact = buildContactSetup<2>(sc, materialStats(f.w.particles, 1));
     f.s.integrator = IntegratorKind::Gear5;
     f.s.dt = f.w.contact.polygonStep;
     f.s.skin = 0.2 * kR;
@@ -155,7 +155,7 @@ TEST(PolygonStatic, DiskOnPolygonAndPolygonOnDisk) {
             const double top = Rb / std::sqrt(17.0);
             w.particles.add(V2{{0.001, top + kR}}, V2::zero(), Ang<2>::zero(), kR, kDensity, 0, 1);
         }
-        w.contact = buildContactSetup(sc, materialStats(w.particles, 1));
+        w.contact = buildContactSetup<2>(sc, materialStats(w.particles, 1));
         TdmSettings s;
         s.integrator = IntegratorKind::Gear5;
         s.dt = w.contact.polygonStep;
@@ -298,7 +298,7 @@ TEST(PolygonEnergy, HeadOnFlatCollisionConservesEnergy) {
     const auto sq = polygon::rectangle(1.0, kR, 0.0);
     w.particles.addPolygon(V2{{-0.9 * kR, 0}}, V2{{0.2, 0}}, Ang<2>::zero(), 0.0, sq, kDensity, 0, 0);
     w.particles.addPolygon(V2{{0.9 * kR, 0}}, V2{{-0.2, 0}}, Ang<2>::zero(), 0.0, sq, kDensity, 0, 1);
-    w.contact = buildContactSetup(sc, materialStats(w.particles, 1));
+    w.contact = buildContactSetup<2>(sc, materialStats(w.particles, 1));
     TdmSettings s;
     s.integrator = IntegratorKind::Gear5;
     s.dt = w.contact.polygonStep / 16;

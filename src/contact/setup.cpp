@@ -92,18 +92,119 @@ HeadOnResult simulateHeadOn(NormalLaw law, HertzDamping damping, const PairCoeff
     return {std::numeric_limits<double>::quiet_NaN(), t, dmax};
 }
 
-ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialStats>& stats) {
+namespace {
+
+/// What every law's set-up reads of one material pair: the two materials, the mixed restitution and the
+/// reference contact (two mean particles of the materials) for coefficients that depend on the masses.
+struct PairRef {
+    const MaterialProps& a;
+    const MaterialProps& b;
+    double e = 1, lne = 0;            ///< e_ab = sqrt(e_a e_b) and its logarithm
+    double meffRef = 0, reffRef = 0;  ///< [kg], [m]
+};
+
+/// Linear spring-dashpot (docs/physics.md B.2) from a fixed k_n (and gamma_n), or from (e, t_c).
+void setUpLinear(PairCoeffs& c, const ContactModelDef& cd, const PairRef& p) {
+    if (cd.kn) {
+        c.knConst = *cd.kn;
+        if (cd.gammaN) {
+            c.gnPerMeff = *cd.gammaN;
+        } else {
+            // gamma_n = -2 ln(e) sqrt(m_eff k_n / (pi^2 + ln^2 e)): exact for the reference pair
+            c.gnPerMeff = -2 * p.lne * std::sqrt(*cd.kn / (p.meffRef * (kPi * kPi + p.lne * p.lne)));
+        }
+    } else if (cd.duration) {
+        const double tc = *cd.duration;
+        c.knPerMeff = (kPi * kPi + p.lne * p.lne) / (tc * tc);
+        c.gnPerMeff = -2 * p.lne / tc;
+    }
+}
+
+/// Duration of a contact of the linear law between partners of effective mass meff: pi over the damped
+/// frequency (the undamped one when the damping is supercritical).
+double linearContactTime(const PairCoeffs& c, double meff) {
+    const double kn = c.knConst + c.knPerMeff * meff;
+    const double eta = 0.5 * c.gnPerMeff;
+    const double w2 = kn / meff - eta * eta;
+    return w2 > 0 ? kPi / std::sqrt(w2) : kPi * std::sqrt(meff / kn);
+}
+
+/// Elastic Hertz contact duration t_c = 2.868 (m_eff^2 / (R_eff E_eff^2 v))^(1/5) (docs/physics.md B.3).
+double hertzContactTime(const PairCoeffs& c, double meff, double reff, double v) {
+    const double eEff = 0.75 * c.hertzK;
+    return 2.868 * std::pow(meff * meff / (reff * eEff * eEff * v), 0.2);
+}
+
+/// Hertz with viscoelastic or Tsuji damping (docs/physics.md B.3): E_eff from the two materials, the damping
+/// solved for the restitution e_ab at the impact velocity under the contact-ending rule in force.
+void setUpHertz(PairCoeffs& c, const ContactModelDef& cd, const PairRef& p) {
+    const double ea = (1 - p.a.poisson * p.a.poisson) / p.a.young;
+    const double eb = (1 - p.b.poisson * p.b.poisson) / p.b.young;
+    c.hertzK = (4.0 / 3.0) / (ea + eb);
+    if (cd.hertzDamping == HertzDamping::Tsuji) {
+        // Tsuji's alpha(e) fit assumes the contact ends at zero overlap; with the force clipped at zero the same
+        // alpha gives a larger e. Solve for the alpha that gives e under the rule in force, starting from the fit
+        // (the collision is speed-independent for this law).
+        c.tsujiAlpha = cd.attraction ? tsujiAlpha(p.e)
+                                     : solveHertzDamping(
+                                           c, HertzDamping::Tsuji, [](PairCoeffs& pc, double x) { pc.tsujiAlpha = x; },
+                                           std::max(tsujiAlpha(p.e), 1e-3), p.e, p.meffRef, p.reffRef,
+                                           cd.impactVelocity, cd.attraction);
+    } else if (cd.hertzDamping == HertzDamping::Viscoelastic) {
+        if (p.a.dissipationTime && p.b.dissipationTime) {
+            c.dissipationTime = 0.5 * (*p.a.dissipationTime + *p.b.dissipationTime);
+        } else {
+            // The elastic contact time bounds any sensible A*.
+            const double tcRef = hertzContactTime(c, p.meffRef, p.reffRef, cd.impactVelocity);
+            c.dissipationTime = solveHertzDamping(
+                c, HertzDamping::Viscoelastic, [](PairCoeffs& pc, double x) { pc.dissipationTime = x; }, tcRef, p.e,
+                p.meffRef, p.reffRef, cd.impactVelocity, cd.attraction);
+        }
+    }
+}
+
+/// Cundall-Strack spring (docs/physics.md B.4): k_t fixed, or k_t / k_n = q / (1 + q) with q = 1/2 for disks and
+/// 2/5 for spheres (the ratio that makes normal and tangential oscillations of a contact equally fast).
+template <int D>
+void setUpSpring(PairCoeffs& c, const ContactModelDef& cd) {
+    constexpr double q = D == 2 ? 0.5 : 0.4;
+    if (cd.kt)
+        c.ktConst = *cd.kt;
+    else
+        c.ktRatio = cd.ktRatio ? *cd.ktRatio : q / (1 + q);
+    c.gtPerMeff = cd.gammaT;
+}
+
+/// Overlap-area law of polygon contacts (docs/physics.md G.3): Y_ab = 2 Y_a Y_b / (Y_a + Y_b). Damping from e:
+/// for a flat contact as wide as l the law is a linear spring-dashpot with damping ratio gamma/2, so
+/// gamma = 2 (-ln e)/sqrt(pi^2 + ln^2 e) gives e there.
+polygon::PolygonCoeffs polygonCoeffs(const ContactModelDef& cd, const PairRef& p, double mu) {
+    polygon::PolygonCoeffs pc;
+    pc.young = 2 * p.a.young * p.b.young / (p.a.young + p.b.young);
+    pc.gamma = cd.polygonDamping ? *cd.polygonDamping : -2 * p.lne / std::sqrt(kPi * kPi + p.lne * p.lne);
+    pc.mu = mu;
+    pc.law = cd.polygonLaw;
+    if (cd.tangential == TangentialLaw::Spring) {
+        pc.kt = cd.kt ? *cd.kt : (cd.ktRatio ? *cd.ktRatio : 2.0 / 7.0) * pc.young;
+        pc.gammaT = p.e < 1 ? 0.25 : 0.0;  // Matuttis-Chen's 0.25 sqrt(k_t m_t); none in an elastic scene
+    }
+    return pc;
+}
+
+}  // namespace
+
+template <int D>
+ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<MaterialProps>& materials,
+                               const std::vector<MaterialStats>& stats) {
     ContactSetup s;
-    const ContactDef& cd = sc.contact;
     s.normal = cd.normal;
     s.hertzDamping = cd.normal == NormalLaw::Hertz ? cd.hertzDamping : HertzDamping::None;
     s.tangential = cd.tangential;
     s.attraction = cd.attraction;
-    const int nm = static_cast<int>(sc.materials.size());
+    const int nm = static_cast<int>(materials.size());
     s.nMaterials = nm;
     s.table.resize(nm * nm);
     s.polygonTable.resize(nm * nm);
-    const double q = sc.dimension == 2 ? 0.5 : 0.4;
 
     // Reference particle of each material (materials without particles borrow the overall mean).
     MaterialStats all;
@@ -126,86 +227,33 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
 
     for (int a = 0; a < nm; ++a) {
         for (int b = 0; b < nm; ++b) {
-            const MaterialDef& ma = sc.materials[a];
-            const MaterialDef& mb = sc.materials[b];
-            PairCoeffs c;
+            const MaterialProps& ma = materials[a];
+            const MaterialProps& mb = materials[b];
+            const MaterialStats ra = ref(a), rb = ref(b);
             const double e = std::sqrt(ma.restitution * mb.restitution);
+            const PairRef p{ma,
+                            mb,
+                            e,
+                            std::log(e),
+                            ra.meanMass * rb.meanMass / (ra.meanMass + rb.meanMass),
+                            ra.meanRadius * rb.meanRadius / (ra.meanRadius + rb.meanRadius)};
+            PairCoeffs c;
             c.mu = std::sqrt(ma.friction * mb.friction);
             c.beta0 = 0.5 * (ma.tangentialRestitution + mb.tangentialRestitution);
-            const double lne = std::log(e);
-            const MaterialStats ra = ref(a), rb = ref(b);
-            const double meffRef = ra.meanMass * rb.meanMass / (ra.meanMass + rb.meanMass);
-            const double reffRef = ra.meanRadius * rb.meanRadius / (ra.meanRadius + rb.meanRadius);
-            if (cd.normal == NormalLaw::Linear) {
-                if (cd.kn) {
-                    c.knConst = *cd.kn;
-                    if (cd.gammaN) {
-                        c.gnPerMeff = *cd.gammaN;
-                    } else {
-                        // gamma_n = -2 ln(e) sqrt(m_eff k_n / (pi^2 + ln^2 e)): exact for the reference pair
-                        c.gnPerMeff = -2 * lne * std::sqrt(*cd.kn / (meffRef * (kPi * kPi + lne * lne)));
-                    }
-                } else if (cd.duration) {
-                    const double tc = *cd.duration;
-                    c.knPerMeff = (kPi * kPi + lne * lne) / (tc * tc);
-                    c.gnPerMeff = -2 * lne / tc;
-                }
-            } else {
-                const double ea = (1 - ma.poisson * ma.poisson) / ma.young;
-                const double eb = (1 - mb.poisson * mb.poisson) / mb.young;
-                c.hertzK = (4.0 / 3.0) / (ea + eb);
-                if (cd.hertzDamping == HertzDamping::Tsuji) {
-                    // Tsuji's alpha(e) fit assumes the contact ends at zero overlap; with the force clipped at
-                    // zero the same alpha gives a larger e. Solve for the alpha that gives e under the rule in
-                    // force, starting from the fit (the collision is speed-independent for this law).
-                    c.tsujiAlpha =
-                        cd.attraction
-                            ? tsujiAlpha(e)
-                            : solveHertzDamping(
-                                  c, HertzDamping::Tsuji, [](PairCoeffs& pc, double x) { pc.tsujiAlpha = x; },
-                                  std::max(tsujiAlpha(e), 1e-3), e, meffRef, reffRef, cd.impactVelocity, cd.attraction);
-                } else if (cd.hertzDamping == HertzDamping::Viscoelastic) {
-                    if (ma.dissipationTime && mb.dissipationTime) {
-                        c.dissipationTime = 0.5 * (*ma.dissipationTime + *mb.dissipationTime);
-                    } else {
-                        // The elastic contact time bounds any sensible A*.
-                        const double eEff = 0.75 * c.hertzK;
-                        const double tcRef =
-                            2.868 * std::pow(meffRef * meffRef / (reffRef * eEff * eEff * cd.impactVelocity), 0.2);
-                        c.dissipationTime = solveHertzDamping(
-                            c, HertzDamping::Viscoelastic, [](PairCoeffs& pc, double x) { pc.dissipationTime = x; },
-                            tcRef, e, meffRef, reffRef, cd.impactVelocity, cd.attraction);
-                    }
-                }
-            }
-            if (cd.tangential == TangentialLaw::Spring) {
-                if (cd.kt)
-                    c.ktConst = *cd.kt;
-                else
-                    c.ktRatio = cd.ktRatio ? *cd.ktRatio : q / (1 + q);
-                c.gtPerMeff = cd.gammaT;
-            }
+            if (cd.normal == NormalLaw::Linear)
+                setUpLinear(c, cd, p);
+            else
+                setUpHertz(c, cd, p);
+            if (cd.tangential == TangentialLaw::Spring) setUpSpring<D>(c, cd);
             // The restitution the soft law really produces (contact-ending rule included), for the EDM.
             // (A polygon-only scene may leave the linear law without coefficients: nothing to simulate.)
             const bool haveDiskLaw = cd.normal == NormalLaw::Hertz || cd.kn || cd.duration;
-            c.restitution = haveDiskLaw ? simulateHeadOn(s.normal, s.hertzDamping, c, meffRef, reffRef,
+            c.restitution = haveDiskLaw ? simulateHeadOn(s.normal, s.hertzDamping, c, p.meffRef, p.reffRef,
                                                          cd.impactVelocity, cd.attraction)
                                               .restitution
                                         : e;
             s.table[a * nm + b] = c;
-
-            // Polygon law (PHYSICS.md G.3). Damping from e: for a flat contact as wide as l the law is a linear
-            // spring-dashpot with damping ratio gamma/2, so gamma = 2 (-ln e)/sqrt(pi^2 + ln^2 e) gives e there.
-            polygon::PolygonCoeffs pc;
-            pc.young = 2 * ma.young * mb.young / (ma.young + mb.young);
-            pc.gamma = cd.polygonDamping ? *cd.polygonDamping : -2 * lne / std::sqrt(kPi * kPi + lne * lne);
-            pc.mu = c.mu;
-            pc.law = cd.polygonLaw;
-            if (cd.tangential == TangentialLaw::Spring) {
-                pc.kt = cd.kt ? *cd.kt : (cd.ktRatio ? *cd.ktRatio : 2.0 / 7.0) * pc.young;
-                pc.gammaT = e < 1 ? 0.25 : 0.0;  // Matuttis-Chen's 0.25 sqrt(k_t m_t); none in an elastic scene
-            }
-            s.polygonTable[a * nm + b] = pc;
+            s.polygonTable[a * nm + b] = polygonCoeffs(cd, p, c.mu);
         }
     }
 
@@ -213,20 +261,9 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
     const double meffMin = 0.5 * all.minMass;
     const double reffMin = 0.5 * all.minRadius;
     double tc = std::numeric_limits<double>::infinity();
-    for (int a = 0; a < nm; ++a)
-        for (int b = 0; b < nm; ++b) {
-            const PairCoeffs& c = s.table[a * nm + b];
-            if (cd.normal == NormalLaw::Linear) {
-                const double kn = c.knConst + c.knPerMeff * meffMin;
-                const double eta = 0.5 * c.gnPerMeff;
-                const double w2 = kn / meffMin - eta * eta;
-                tc = std::min(tc, w2 > 0 ? kPi / std::sqrt(w2) : kPi * std::sqrt(meffMin / kn));
-            } else {
-                const double eEff = 0.75 * c.hertzK;
-                tc = std::min(tc,
-                              2.868 * std::pow(meffMin * meffMin / (reffMin * eEff * eEff * cd.impactVelocity), 0.2));
-            }
-        }
+    for (const PairCoeffs& c : s.table)
+        tc = std::min(tc, cd.normal == NormalLaw::Linear ? linearContactTime(c, meffMin)
+                                                         : hertzContactTime(c, meffMin, reffMin, cd.impactVelocity));
     s.contactTime = tc;
     s.diskContactTime = tc;
     if (cd.normal == NormalLaw::Linear)
@@ -264,5 +301,10 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
     }
     return s;
 }
+
+template ContactSetup buildContactSetup<2>(const ContactModelDef&, const std::vector<MaterialProps>&,
+                                           const std::vector<MaterialStats>&);
+template ContactSetup buildContactSetup<3>(const ContactModelDef&, const std::vector<MaterialProps>&,
+                                           const std::vector<MaterialStats>&);
 
 }  // namespace haet

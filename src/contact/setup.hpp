@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "contact/laws.hpp"
-#include "polygon/contact.hpp"
-#include "scenario/definition.hpp"
+#include "contact/model.hpp"
+#include "contact/polygon_coeffs.hpp"
 
 namespace haet {
 
@@ -46,8 +46,13 @@ struct ContactSetup {
     const polygon::PolygonCoeffs& polygonPair(int a, int b) const { return polygonTable[a * nMaterials + b]; }
 };
 
-/// Builds the coefficient table. stats has one entry per material (count 0 for wall-only materials).
-ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialStats>& stats);
+/// Builds the coefficient table of particles in D dimensions from the contact laws, the materials (one entry per
+/// material, in the order of their indices) and the sizes of their particles (stats: one entry per material,
+/// count 0 for wall-only materials). Each law mixes the two materials' properties and derives its coefficients
+/// in its own set-up function (setup.cpp), with its own contact duration for the time-step rule.
+template <int D>
+ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<MaterialProps>& materials,
+                               const std::vector<MaterialStats>& stats);
 
 /// Result of integrating one head-on collision of the soft law (PHYSICS.md B.2/B.3).
 struct HeadOnResult {

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/polygon_shape.hpp"
 #include "core/vec.hpp"
 
 namespace haet {
@@ -130,37 +131,14 @@ struct Particles {
                            std::vector<Vec<2>> body, double density, std::uint16_t mat, std::uint64_t pid,
                            std::uint8_t flag = 0) {
         static_assert(D == 2, "polygons exist only in 2D");
-        double a2 = 0, mx = 0, my = 0;
-        const std::size_t nv = body.size();
-        for (std::size_t k = 0; k < nv; ++k) {
-            const Vec<2>& p = body[k];
-            const Vec<2>& q = body[(k + 1) % nv];
-            const double cr = p[0] * q[1] - q[0] * p[1];
-            a2 += cr;
-            mx += (p[0] + q[0]) * cr;
-            my += (p[1] + q[1]) * cr;
-        }
-        if (a2 < 0) {
-            std::reverse(body.begin(), body.end());
-            a2 = -a2, mx = -mx, my = -my;
-        }
-        const Vec<2> c{{mx / (3 * a2), my / (3 * a2)}};
-        double r2 = 0, io = 0;
-        for (Vec<2>& p : body) p -= c;
-        for (std::size_t k = 0; k < nv; ++k) {
-            const Vec<2>& p = body[k];
-            const Vec<2>& q = body[(k + 1) % nv];
-            const double cr = p[0] * q[1] - q[0] * p[1];
-            io += cr * (p[0] * p[0] + p[0] * q[0] + q[0] * q[0] + p[1] * p[1] + p[1] * q[1] + q[1] * q[1]);
-            r2 = std::max(r2, norm2(p));
-        }
-        const double area = 0.5 * a2;
-        const std::size_t i = add(pos, vel, spin, std::sqrt(r2), density, mat, pid, flag);
+        const polygon::BodyFrame frame = polygon::toBodyFrame(body);
+        const double area = frame.area;
+        const std::size_t i = add(pos, vel, spin, frame.circumradius, density, mat, pid, flag);
         // The first polygon gives the disks before it kNoShape entries and orientations.
         shape.resize(x.size(), kNoShape);
         angle.resize(x.size(), Ang<D>::zero());
         const double m = density * area;
-        const double ipm = (io / 12.0) / area;  // about the centroid, which is now the origin
+        const double ipm = frame.inertiaPerMass;
         mass[i] = m;
         invMass[i] = (flag & kFrozen) ? 0.0 : 1.0 / m;
         invInertia[i] = (flag & kFrozen) ? 0.0 : 1.0 / (ipm * m);

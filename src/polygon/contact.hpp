@@ -30,20 +30,10 @@
 // and r_i, r_j, the relative velocity and the tangential force are taken at P.
 #include <cmath>
 
+#include "contact/polygon_coeffs.hpp"
 #include "polygon/geometry.hpp"
-#include "scenario/definition.hpp"
 
 namespace haet::polygon {
-
-/// Coefficients of the polygon law for one material pair (built once, contact/setup.cpp).
-struct PolygonCoeffs {
-    double young = 0;                          ///< Y [N/m] (2D: stiffness per length), F_el = Y A / l
-    double gamma = 0;                          ///< normal damping, dimensionless (PHYSICS.md G.3)
-    double kt = 0;                             ///< tangential spring stiffness [N/m]; 0 = no tangential force
-    double gammaT = 0;                         ///< tangential damping: F = -gammaT sqrt(k_t m_t) g_t [-]
-    double mu = 0;                             ///< Coulomb friction [-]
-    PolygonLaw law = PolygonLaw::OverlapArea;  ///< normal force: G.3, or the energy-conserving variant
-};
 
 /// Lengths of a pair that the law takes from the bodies' bounding radii.
 struct PairLengths {

@@ -198,29 +198,6 @@ private:
     std::string note_;
 };
 
-/// The hybrid's settings from the scenario, with the documented defaults (PHYSICS.md A).
-inline HaetSettings haetSettings(const Scenario& sc) {
-    HaetSettings hs;
-    hs.zones.size = sc.haet.zoneSize.value_or(0.0);
-    hs.zones.phiOn = sc.haet.phiOn.value_or(sc.dimension == 2 ? 0.45 : 0.30);
-    hs.zones.phiOff = sc.haet.phiOff.value_or(sc.dimension == 2 ? 0.40 : 0.25);
-    hs.zones.buffer = sc.haet.buffer;
-    hs.relabelEvery = sc.haet.relabelEvery;
-    hs.diluteSteps = sc.haet.diluteSteps;
-    hs.dtMin = sc.haet.dtMin.value_or(0.0);
-    return hs;
-}
-
-inline EdmSettings edmSettings(const Scenario& sc) {
-    EdmSettings es;
-    es.cellSize = sc.edm.cellSize.value_or(0.0);
-    es.tangential = sc.edm.tangential == EdmTangential::Constant ? EdmSettings::Tangential::Constant
-                                                                 : EdmSettings::Tangential::Walton;
-    es.tcModel = sc.edm.tcModel;
-    es.tcTime = sc.edm.tcTime.value_or(0.0);
-    return es;
-}
-
 template <int D>
 std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
     switch (sc.method) {
@@ -238,7 +215,7 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
         case Method::Haet: {
             std::string note;
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
-            return std::make_unique<HaetDriver<D>>(world, ts, edmSettings(sc), haetSettings(sc), note);
+            return std::make_unique<HaetDriver<D>>(world, ts, edmSettings(sc), haetSettings<D>(sc), note);
         }
     }
     throw ScenarioError({sc.path, 0}, "method", "unknown method");
@@ -561,6 +538,15 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     return status;
 }
 
+/// The sections of docs/physics.md behind what `haet check` prints for the time-driven side of a run.
+std::string tdmReferences(const Scenario& sc, IntegratorKind integrator, bool polygons) {
+    std::string r = sc.contact.normal == NormalLaw::Linear ? "B.2 linear spring-dashpot" : "B.3 Hertz";
+    if (sc.contact.tangential == TangentialLaw::Spring) r += ", B.4 tangential spring";
+    if (polygons) r += ", G polygons";
+    r += integrator == IntegratorKind::Gear5 ? ", F.1 Gear predictor-corrector" : ", F.2 velocity Verlet";
+    return r + ", F.3 time step";
+}
+
 template <int D>
 void describeTdm(const Scenario& sc, std::ostream& out) {
     World<D> world = buildWorld<D>(sc);
@@ -601,6 +587,8 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
     for (std::size_t a = 0; a < sc.materials.size(); ++a)
         out << fmt::format("material   {}: restitution of the soft law {:.5f} (incl. contact-end rule)\n",
                            sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+    out << fmt::format("physics    docs/physics.md {}\n",
+                       tdmReferences(sc, ts.integrator, world.particles.hasPolygons()));
 }
 
 }  // namespace
@@ -623,6 +611,8 @@ void describeEdm(const Scenario& sc, std::ostream& out) {
     for (std::size_t a = 0; a < sc.materials.size(); ++a)
         out << fmt::format("material   {}: restitution {:.5f} (the soft law's, incl. contact-end rule)\n",
                            sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+    out << fmt::format("physics    docs/physics.md C.1-C.2 collision rule, D.2-D.4 event times, D.6 invalid states{}\n",
+                       sc.edm.tcModel ? ", D.7 TC model" : "");
 }
 
 template <int D>
@@ -630,7 +620,7 @@ void describeHaet(const Scenario& sc, std::ostream& out) {
     World<D> world = buildWorld<D>(sc);
     std::string dtNote;
     const TdmSettings ts = tdmSettings<D>(sc, world, &dtNote);
-    const HaetEngine<D> eng(world, ts, edmSettings(sc), haetSettings(sc));
+    const HaetEngine<D> eng(world, ts, edmSettings(sc), haetSettings<D>(sc));
     const HaetSettings& hs = eng.settings();
     out << fmt::format("scenario   {} ({})\n", sc.name, sc.path);
     out << fmt::format("method     haet (time-driven where dense, event-driven where dilute), {}D, integrator {}\n", D,
@@ -657,6 +647,10 @@ void describeHaet(const Scenario& sc, std::ostream& out) {
         out << fmt::format(
             "material   {}: restitution {:.5f} in both engines (the soft law's, incl. contact-end rule)\n",
             sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+    out << fmt::format(
+        "physics    docs/physics.md A.1 one physics, A.2 zones, A.4 modified EDM; {}; C.1-C.2 collision rule, "
+        "D.2-D.4 event times\n",
+        tdmReferences(sc, ts.integrator, false));
 }
 
 void describeScenario(const Scenario& sc, std::ostream& out) {

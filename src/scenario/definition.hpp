@@ -9,17 +9,13 @@
 #include <string>
 #include <vector>
 
+#include "contact/model.hpp"
+
 namespace haet {
 
 using Vec3d = std::array<double, 3>;
 
 enum class Method { Tdm, Edm, Haet };
-enum class NormalLaw { Linear, Hertz };
-enum class HertzDamping { None, Viscoelastic, Tsuji };
-enum class TangentialLaw { None, Spring };
-/// Normal force of contacts involving a polygon (PHYSICS.md G.3; docs/scenario.md, Polygons).
-enum class PolygonLaw { OverlapArea, Potential };
-enum class IntegratorKind { Verlet, Gear5 };
 enum class Arrangement { Lattice, Random, File };
 enum class FileFormat { Csv, LammpsData };
 enum class ShapeKind { Disk, Polygon };
@@ -58,35 +54,14 @@ struct DomainDef {
     Vec3d gravity{0, 0, 0};                             ///< [m/s^2]
 };
 
-struct MaterialDef {
+/// A [materials.NAME] table: the properties the contact laws read (contact/model.hpp) and where they were set.
+struct MaterialDef : MaterialProps {
     std::string name;
-    double density = 2500;                  ///< [kg/m^3] (2D: [kg/m^2], areal)
-    double young = 1e7;                     ///< Young's modulus [Pa] (2D: stiffness per length [N/m]); Hertz only
-    double poisson = 0.3;                   ///< Poisson ratio [-]; Hertz only
-    double restitution = 0.9;               ///< normal coefficient of restitution e [-], 0 < e <= 1
-    double friction = 0.5;                  ///< Coulomb friction coefficient mu [-]
-    double tangentialRestitution = 1.0;     ///< beta0 of Walton's rule (event-driven engine) [-], -1..1
-    std::optional<double> dissipationTime;  ///< viscoelastic Hertz A* [s]; default: from e at impact_velocity
     SourcePos pos;
 };
 
-struct ContactDef {
-    NormalLaw normal = NormalLaw::Linear;
-    /// Linear law from (e, t_c): contact duration [s]. Either duration, or kn (+ gamma_n), must be set.
-    std::optional<double> duration;
-    std::optional<double> kn;      ///< linear normal stiffness [N/m], overrides duration
-    std::optional<double> gammaN;  ///< normal damping, LAMMPS convention F = -m_eff gamma_n v_n [1/s]
-    HertzDamping hertzDamping = HertzDamping::Viscoelastic;
-    TangentialLaw tangential = TangentialLaw::Spring;
-    std::optional<double> kt;       ///< tangential stiffness [N/m]; default kt_ratio * kn
-    std::optional<double> ktRatio;  ///< kt/kn [-]; default q/(1+q): 2/7 spheres, 1/3 disks
-    double gammaT = 0;              ///< tangential damping, LAMMPS convention [1/s]
-    bool attraction = false;        ///< false: normal force clipped at zero (no attraction while separating)
-    double impactVelocity = 1.0;    ///< Hertz: impact speed used for t_c and the time-step rule [m/s]
-    /// Polygon contacts: dimensionless normal damping gamma of PHYSICS.md G.3; default from the restitution
-    std::optional<double> polygonDamping;
-    /// Polygon contacts: F = Y A / l at the overlap centroid (G.3), or the energy-conserving F = Y A |c| / L^2
-    PolygonLaw polygonLaw = PolygonLaw::OverlapArea;
+/// The [contact] section: the laws and their parameters (contact/model.hpp) and where they were set.
+struct ContactDef : ContactModelDef {
     SourcePos pos;
 };
 

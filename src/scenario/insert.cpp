@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "polygon/geometry.hpp"
+#include "core/polygon_shape.hpp"
 #include "scenario/text.hpp"
 
 namespace haet {

@@ -7,8 +7,8 @@
 #include <memory>
 #include <vector>
 
+#include "contact/kinds.hpp"
 #include "neighbor/pair_list.hpp"
-#include "scenario/definition.hpp"
 #include "tdm/forces.hpp"
 #include "tdm/integrators.hpp"
 #include "world/world.hpp"

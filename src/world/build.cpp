@@ -33,6 +33,12 @@ std::vector<MaterialStats> materialStats(const Particles<D>& p, int nMaterials) 
 }
 
 template <int D>
+ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialStats>& stats) {
+    const std::vector<MaterialProps> props(sc.materials.begin(), sc.materials.end());
+    return buildContactSetup<D>(static_cast<const ContactModelDef&>(sc.contact), props, stats);
+}
+
+template <int D>
 static Vec<D> toVec(const Vec3d& a) {
     Vec<D> v;
     for (int k = 0; k < D; ++k) v[k] = a[k];
@@ -56,7 +62,7 @@ World<D> buildWorld(const Scenario& sc) {
         w.walls.push_back(wall);
     }
     insertParticles<D>(sc, w.particles, Rng(sc.seed, RngStream::Insert));
-    w.contact = buildContactSetup(sc, materialStats(w.particles, static_cast<int>(sc.materials.size())));
+    w.contact = buildContactSetup<D>(sc, materialStats(w.particles, static_cast<int>(sc.materials.size())));
     return w;
 }
 
@@ -99,11 +105,39 @@ TdmSettings tdmSettings(const Scenario& sc, const World<D>& w, std::string* dtNo
     return s;
 }
 
+EdmSettings edmSettings(const Scenario& sc) {
+    EdmSettings es;
+    es.cellSize = sc.edm.cellSize.value_or(0.0);
+    es.tangential = sc.edm.tangential == EdmTangential::Constant ? EdmSettings::Tangential::Constant
+                                                                 : EdmSettings::Tangential::Walton;
+    es.tcModel = sc.edm.tcModel;
+    es.tcTime = sc.edm.tcTime.value_or(0.0);
+    return es;
+}
+
+template <int D>
+HaetSettings haetSettings(const Scenario& sc) {
+    HaetSettings hs;
+    hs.zones.size = sc.haet.zoneSize.value_or(0.0);
+    // Default thresholds (docs/haet.md): disks pack denser than spheres, so their dense phase starts higher.
+    hs.zones.phiOn = sc.haet.phiOn.value_or(D == 2 ? 0.45 : 0.30);
+    hs.zones.phiOff = sc.haet.phiOff.value_or(D == 2 ? 0.40 : 0.25);
+    hs.zones.buffer = sc.haet.buffer;
+    hs.relabelEvery = sc.haet.relabelEvery;
+    hs.diluteSteps = sc.haet.diluteSteps;
+    hs.dtMin = sc.haet.dtMin.value_or(0.0);
+    return hs;
+}
+
 template World<2> buildWorld<2>(const Scenario&);
 template World<3> buildWorld<3>(const Scenario&);
 template TdmSettings tdmSettings<2>(const Scenario&, const World<2>&, std::string*);
 template TdmSettings tdmSettings<3>(const Scenario&, const World<3>&, std::string*);
 template std::vector<MaterialStats> materialStats<2>(const Particles<2>&, int);
 template std::vector<MaterialStats> materialStats<3>(const Particles<3>&, int);
+template HaetSettings haetSettings<2>(const Scenario&);
+template HaetSettings haetSettings<3>(const Scenario&);
+template ContactSetup buildContactSetup<2>(const Scenario&, const std::vector<MaterialStats>&);
+template ContactSetup buildContactSetup<3>(const Scenario&, const std::vector<MaterialStats>&);
 
 }  // namespace haet
