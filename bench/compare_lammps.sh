@@ -7,15 +7,18 @@
 #    bench/make_chute_data.sh and lets LAMMPS flow it for PREP_STEPS steps (bench/lammps/in.chute<case>.prep).
 # (5. below: both codes timed again in short windows, the fastest of each compared.)
 # 2. LAMMPS times STEPS steps from that state (bench/lammps/in.chute<case>.time), under /usr/bin/time -v.
-# 3. HAET runs bench/chute<case>.toml from the same file with --threads 1 and --threads 2, under /usr/bin/time -v.
+# 3. HAET runs examples/lammps_chute<case>.toml from the same file with --threads 1 and --threads 2, under
+#    /usr/bin/time -v (other step counts by `haet run --set duration=...`).
 # 4. Idle baselines: both codes run the same input on a data file with 1 particle in the same box, 10 steps.
-# Prints a table, and writes bench/results/chute_<host>.csv (rows of this case replaced, others kept).
+# Prints a table, and appends its rows to bench/results/MACHINE/lammps_chute.csv (MACHINE: the processor, from
+# /proc/cpuinfo, or $MACHINE; columns: bench/results/README.md).
 # Time per particle-step = wall time of the stepping loop / (particles x steps), particles counting the
 # frozen base; bytes per particle = (peak RSS - idle peak RSS) / particles.
 #
 # Environment: STEPS (5000), PREP_STEPS (80000), HAET_THREADS ("1 2"), HAET_SKIP=1 (LAMMPS half only),
 #              WINDOW_ROUNDS (8; 0: no windows),
-#              HAET_TIMEOUT (s; default 20 x LAMMPS's loop time + 60), LMP (lmp). Exit status: 0 all measured; 1 a half failed (the other is still reported); 2 usage.
+#              HAET_TIMEOUT (s; default 20 x LAMMPS's loop time + 60), LMP (lmp), MACHINE, NOTE (a note for the
+#              CSV rows). Exit status: 0 all measured; 1 a half failed (the other is still reported); 2 usage.
 set -euo pipefail
 
 usage() { echo "usage: $0 BUILD_DIR [3d|2d]" >&2; exit 2; }
@@ -25,6 +28,7 @@ case $case in 3d|2d) ;; *) usage ;; esac
 [ -d "$1" ] || { echo "$0: build directory not found: $1" >&2; exit 2; }
 build=$(cd "$1" && pwd)
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+root=$(cd "$here/.." && pwd)
 data=$here/data
 name=chute$case
 runs=$data/runs/$name
@@ -34,13 +38,15 @@ HAET_THREADS=${HAET_THREADS:-1 2}
 LMP=${LMP:-lmp}
 IDLE_STEPS=10
 haet=$build/haet
-host=$(hostname -s 2>/dev/null || hostname)
-csv=$here/results/chute_$host.csv
+# shellcheck source=bench/lib.sh
+. "$here/lib.sh"
+machine=${MACHINE:-$(machine_name)}
+csv=$here/results/$machine/lammps_chute.csv
 status=0
 
 command -v "$LMP" >/dev/null || { echo "$0: LAMMPS ($LMP) not found (Debian: apt-get install lammps)" >&2; exit 1; }
 [ -x /usr/bin/time ] || { echo "$0: /usr/bin/time not found (Debian: apt-get install time)" >&2; exit 1; }
-mkdir -p "$data" "$runs" "$here/results"
+mkdir -p "$data" "$runs" "$(dirname "$csv")"
 
 log() { printf '%s\n' "$*" >&2; }
 
@@ -114,22 +120,18 @@ check_domain() {
         }' "$toml" "$file"
 }
 
-# The scenario HAET runs: bench/<name>.toml as it stands for the default STEPS, else a copy in bench/data/
-# with the duration changed (the particle file is named relative to the scenario's folder).
-scenario=$here/$name.toml
+# The scenario HAET runs: examples/lammps_<name>.toml as it stands for the default STEPS, else with the duration
+# and the series period overridden (dt = 1e-4).
+scenario=$root/examples/lammps_$name.toml
 thermo=$(( STEPS >= 5 ? STEPS / 5 : 1 ))   # LAMMPS thermo and HAET series rows, 1 000 steps for the default
+sets=()
 if [ "$STEPS" != 5000 ]; then
-    scenario=$data/$name.steps$STEPS.toml
-    sed -e "s|^duration = .*|duration = $(calc "print $STEPS * 1e-4")|" \
-        -e "s|^series_period = .*|series_period = $(calc "print $thermo * 1e-4")|" \
-        -e "s|^file = \"data/|file = \"|" "$here/$name.toml" > "$scenario"
+    sets=(--set "duration=$(calc "print $STEPS * 1e-4")" --set "output.series_period=$(calc "print $thermo * 1e-4")")
 fi
 # Idle baseline: the same scenario on the file with 1 particle in the same box.
 idle_data=$data/idle$case.data
 "$here/make_chute_data.sh" "idle$case" "$idle_data" >/dev/null
-idle_toml=$data/idle$case.toml
-sed -e "s|^duration = .*|duration = $(calc "print $IDLE_STEPS * 1e-4")|" \
-    -e "s|^file = .*|file = \"idle$case.data\"|" "$here/$name.toml" > "$idle_toml"
+idle_sets=(--set "duration=$(calc "print $IDLE_STEPS * 1e-4")" --set "insert[1].file=\"$idle_data\"")
 
 # The HAET source the build came from: git HEAD of the tree BUILD_DIR was configured from, "+dirty" when its
 # src/ has uncommitted changes; HAET_COMMIT overrides (e.g. for a build from an exported tree).
@@ -189,7 +191,7 @@ else
         limit=${HAET_TIMEOUT:-$( [ -n "$l_loop" ] && calc "printf \"%d\", 20 * $l_loop + 60" || echo 1800)}
         # Idle: the 1-particle run; `haet --version` when that fails.
         rm -rf "$runs/haet_idle.run"
-        if timed "$runs/haet_idle" timeout 60 "$haet" run "$idle_toml" --out "$runs/haet_idle.run" --quiet --threads 1 &&
+        if timed "$runs/haet_idle" timeout 60 "$haet" run "$scenario" "${idle_sets[@]}" --out "$runs/haet_idle.run" --quiet --threads 1 &&
            [ -s "$runs/haet_idle.run/run.json" ]; then
             h_idle_how="1-particle run"
         else
@@ -203,7 +205,8 @@ else
             rm -rf "$rdir"
             log "HAET: $STEPS steps of $name, --threads $t ..."
             rc=0
-            timed "$runs/haet_t$t" timeout "$limit" "$haet" run "$scenario" --out "$rdir" --quiet --threads "$t" || rc=$?
+            timed "$runs/haet_t$t" timeout "$limit" "$haet" run "$scenario" ${sets[@]+"${sets[@]}"} --out "$rdir" --quiet \
+                --threads "$t" || rc=$?
             if [ "$rc" = 124 ]; then
                 log "HAET --threads $t did not finish in $limit s (HAET_TIMEOUT); stopped"
                 haet_ok=0; break
@@ -326,24 +329,26 @@ if [ "$haet_ok" = 1 ] && [ -n "$l_ns" ]; then
     [ -z "$h_ke" ] || echo "kinetic energy at step $l_kstep (same start, same law): LAMMPS $l_ke, HAET $(calc "printf \"%.8g\", $h_ke")"
 fi
 
-# CSV: one row per HAET thread count (a single row with threads NA when HAET did not run).
-header="case,threads,n_particles,steps,lammps_ns_per_particle_step,haet_ns_per_particle_step,ratio_haet_over_lammps,lammps_bytes_per_particle,haet_bytes_per_particle,haet_speedup_over_1_thread,lammps_cpu_ns_per_particle_step,haet_cpu_ns_per_particle_step,date,haet_commit,load_before,lammps_fastest_window_ns,haet_fastest_window_ns"
+# CSV: one row per HAET thread count (a single row with threads NA when HAET did not run), appended to the
+# machine's file (columns: bench/results/README.md).
+header="case,threads,n_particles,steps,lammps_ns_per_particle_step,haet_ns_per_particle_step,ratio_haet_over_lammps,lammps_bytes_per_particle,haet_bytes_per_particle,haet_speedup_over_1_thread,lammps_cpu_ns_per_particle_step,haet_cpu_ns_per_particle_step,date,haet_commit,load_before,lammps_fastest_window_ns,haet_fastest_window_ns,haet_arch,note"
+haet_arch=$(sed -n 's/^HAET_ARCH:[A-Z]*=//p' "$build/CMakeCache.txt" 2>/dev/null || true)
+haet_arch=${haet_arch:-NA}
+note=$(printf '%s' "${NOTE:-}" | tr ',\n' ';;')
 now=$(date -u +%Y-%m-%dT%H:%M:%SZ)
 rows=()
 if [ "$haet_ok" = 1 ]; then
     for t in $HAET_THREADS; do
-        rows+=("$name,$t,$h_n,$STEPS,$(or_na "$l_ns"),${h_ns[$t]},$(ratio "${h_ns[$t]}" "$l_ns"),$(or_na "$l_bpp"),${h_bpp[$t]},$(ratio "${h_ns[$first]}" "${h_ns[$t]}"),$(or_na "$l_cpu"),${h_cpu[$t]},$now,$haet_commit,$load_before,$(or_na "$w_l"),$(or_na "$w_h")")
+        rows+=("$name,$t,$h_n,$STEPS,$(or_na "$l_ns"),${h_ns[$t]},$(ratio "${h_ns[$t]}" "$l_ns"),$(or_na "$l_bpp"),${h_bpp[$t]},$(ratio "${h_ns[$first]}" "${h_ns[$t]}"),$(or_na "$l_cpu"),${h_cpu[$t]},$now,$haet_commit,$load_before,$(or_na "$w_l"),$(or_na "$w_h"),$haet_arch,$note")
     done
 else
-    rows+=("$name,NA,$(or_na "$l_n"),$STEPS,$(or_na "$l_ns"),NA,NA,$(or_na "$l_bpp"),NA,NA,$(or_na "$l_cpu"),NA,$now,$haet_commit,$load_before,NA,NA")
+    rows+=("$name,NA,$(or_na "$l_n"),$STEPS,$(or_na "$l_ns"),NA,NA,$(or_na "$l_bpp"),NA,NA,$(or_na "$l_cpu"),NA,$now,$haet_commit,$load_before,NA,NA,$haet_arch,$note")
 fi
-tmp=$csv.tmp.$$
-{
-    echo "$header"
-    # rows of the other case, unless the file has other columns (written by an older version of this script)
-    [ -s "$csv" ] && [ "$(head -n 1 "$csv")" = "$header" ] && awk -F, -v c="$name" 'NR > 1 && $1 != c' "$csv"
-    printf '%s\n' "${rows[@]}"
-} > "$tmp"
-mv "$tmp" "$csv"
-echo "wrote bench/${csv#"$here"/}"
+if [ -s "$csv" ] && [ "$(head -n 1 "$csv")" != "$header" ]; then
+    log "warning: $csv has other columns; the rows go to $csv.new"
+    csv=$csv.new
+fi
+[ -s "$csv" ] || echo "$header" > "$csv"
+printf '%s\n' "${rows[@]}" >> "$csv"
+echo "appended to bench/${csv#"$here"/} (commit the rows that record a standing)"
 exit $status

@@ -4,7 +4,7 @@
 #
 #   bench/dilute_compare.sh BUILD_DIR [OUT_DIR]
 #
-# bench/dilute_gas3d.toml and bench/dilute_gas2d.toml (4000 rough inelastic particles, e = 0.9, mu = 0.5, volume
+# examples/dilute_gas3d.toml and examples/dilute_gas2d.toml (4000 rough inelastic particles, e = 0.9, mu = 0.5, volume
 # fraction 0.05, periodic box) run with method = "tdm" and method = "edm": same particles, same material, same
 # simulated time. Prints the CPU time (user + sys, /usr/bin/time) of each and the ratio TDM / EDM of whole runs
 # (goal: >= 50); then the same ratio without the set-up both share (insertion, contact table, outputs, the 2D
@@ -24,14 +24,13 @@ last_col() { awk -F, -v name="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i ==
 
 echo "load average (1 min) before: $(cut -d' ' -f1 /proc/loadavg)"
 for d in 3d 2d; do
-    echo "--- dilute gas $d: $(basename "$here/dilute_gas$d.toml"), one thread"
+    scene=$root/examples/dilute_gas$d.toml
+    echo "--- dilute gas $d: $(basename "$scene"), one thread"
     declare -A cpu=() setup=() ke=()
     for m in tdm edm; do
-        sed "s/^method = .*/method = \"$m\"/" "$here/dilute_gas$d.toml" >"$out/dilute${d}_$m.toml"
-        sed "s/^duration = .*/duration = 1e-6/" "$out/dilute${d}_$m.toml" >"$out/dilute${d}_${m}_setup.toml"
-        run "dilute${d}_${m}_setup" "$out/dilute${d}_${m}_setup.toml"
+        run "dilute${d}_${m}_setup" "$scene" --set "method=$m" --set duration=1e-6
         setup[$m]=$CPU
-        run "dilute${d}_$m" "$out/dilute${d}_$m.toml"
+        run "dilute${d}_$m" "$scene" --set "method=$m"
         cpu[$m]=$CPU
         ke[$m]=$(last_col "$out/dilute${d}_$m/series.csv" kinetic_energy)
         printf "%-4s CPU %8.2f s (set-up %5.2f s)   wall %8.2f s   kinetic energy at the end %s J\n" "$m" "$CPU" \

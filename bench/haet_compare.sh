@@ -6,8 +6,8 @@
 # 1. The flagship demo examples/haet_demo.toml (or $DEMO) run three ways, method = "tdm", "edm" and "haet", same
 #    physics and simulated time. Prints CPU time (user + sys) and wall time of each and the ratios TDM / HAET and
 #    EDM / HAET, and the bound N_total / N_dense (time average of n_tdm in the hybrid's series.csv).
-# 2. The dilute-fraction sweep: bench/haet_sweep.toml with a bed of (1 - f) N disks and a falling cloud of f N that
-#    does not reach the bed within the run, for f in $FRACTIONS; TDM and HAET each. Writes OUT_DIR/haet_sweep.csv
+# 2. The dilute-fraction sweep: examples/bed_and_cloud2d.toml with a bed of (1 - f) N disks and a falling cloud of
+#    f N that does not reach the bed within the run (the counts and the method set by `haet run --set`), for f in $FRACTIONS; TDM and HAET each. Writes OUT_DIR/haet_sweep.csv
 #    (fraction, measured mean event-driven fraction, CPU times, speed-up, bound) and OUT_DIR/haet_sweep.png.
 #
 # CPU times, not wall times, are compared: the machines are shared. OUT_DIR defaults to runs/bench.
@@ -28,8 +28,7 @@ mean_col() { awk -F, -v name="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i ==
 echo "--- demo: $(basename "$demo"), one thread"
 declare -A cpu
 for m in tdm edm haet; do
-    sed "s/^method = .*/method = \"$m\"/" "$demo" >"$out/demo_$m.toml"
-    if run "demo_$m" "$out/demo_$m.toml"; then
+    if run "demo_$m" "$demo" --set "method=$m"; then
         cpu[$m]=$CPU
         printf "%-5s CPU %8.2f s   wall %8.2f s\n" "$m" "$CPU" "$WALL"
     else
@@ -51,8 +50,8 @@ for f in $FRACTIONS; do
     rain=$(awk -v n="$N" -v f="$f" 'BEGIN { printf "%d", n * f + 0.5 }')
     bed=$((N - rain))
     for m in tdm haet; do
-        sed "s/@BED@/$bed/; s/@RAIN@/$rain/; s/@METHOD@/$m/" "$here/haet_sweep.toml" >"$out/sweep_${f}_$m.toml"
-        run "sweep_${f}_$m" "$out/sweep_${f}_$m.toml"
+        run "sweep_${f}_$m" "$root/examples/bed_and_cloud2d.toml" --set "method=$m" --set "insert[1].count=$bed" \
+            --set "insert[2].count=$rain"
         cpu[$m]=$CPU
     done
     series="$out/sweep_${f}_haet/series.csv"

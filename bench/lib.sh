@@ -1,5 +1,25 @@
 # Shared by the benchmark scripts (sourced, not run).
 
+# machine_name: the processor as a directory name of bench/results/ ("amd-epyc-zen4", "intel-xeon-platinum-8375c"):
+# the model name of /proc/cpuinfo in lower case, runs of other characters as "-"; AMD's generation added from the
+# family and model numbers when the name does not hold it (a virtual machine may show only "AMD EPYC").
+machine_name() {
+    awk -F': *' '
+        /^model name/ && name == "" { name = $2 } /^cpu family/ && fam == "" { fam = $2 } /^model\t/ && mod == "" { mod = $2 }
+        END {
+            s = tolower(name); gsub(/\((r|tm)\)|cpu @.*|[0-9]+-core processor|processor/, "", s)
+            gsub(/[^a-z0-9]+/, "-", s); gsub(/^-+|-+$/, "", s); if (s == "") s = "unknown"
+            if (s ~ /^amd/ && s !~ /zen/) {
+                z = ""
+                if (fam == 23) z = "zen2"
+                else if (fam == 25) z = ((mod >= 16 && mod < 32) || (mod >= 96 && mod < 128) || (mod >= 160 && mod < 176)) ? "zen4" : "zen3"
+                else if (fam == 26) z = "zen5"
+                s = s "-" (z != "" ? z : "f" fam "m" mod)
+            }
+            print s
+        }' /proc/cpuinfo 2>/dev/null || echo unknown
+}
+
 # setup SCRIPT BUILD_DIR [OUT_DIR]: the arguments of a comparison script. Sets build, root, out (created;
 # default runs/bench), haet (the binary); exits 2 without BUILD_DIR, 1 without /usr/bin/time.
 setup() {
@@ -16,10 +36,13 @@ setup() {
 
 # The functions below use `haet` (the binary) and `out` (a directory), as setup leaves them.
 
-# run NAME SCENARIO: runs one scenario on one thread into $out/NAME; sets CPU (user + sys, s) and WALL (s).
+# run NAME SCENARIO [--set KEY=VALUE ...]: runs one scenario on one thread into $out/NAME, with the overrides
+# given; sets CPU (user + sys, s) and WALL (s).
 run() {
     local name=$1 scenario=$2
-    /usr/bin/time -f "%U %S %e" -o "$out/$name.time" "$haet" run "$scenario" --out "$out/$name" --threads 1 --quiet
+    shift 2
+    /usr/bin/time -f "%U %S %e" -o "$out/$name.time" "$haet" run "$scenario" "$@" --out "$out/$name" --threads 1 \
+        --quiet
     read -r user sys wall <"$out/$name.time"
     CPU=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.2f", u + s }')
     WALL=$wall

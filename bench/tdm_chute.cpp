@@ -1,9 +1,9 @@
-// The granular chute of bench/compare_lammps.sh (bench/chute3d.toml, chute2d.toml: the LAMMPS flowing state), one
-// thread, timed in short windows of steps. The machine is shared and its speed changes within a minute; the
-// fastest window is what the code costs when nothing else runs, so two builds compare by their minima (and, less
-// sharply, their medians) rather than by the time of a whole run. A window is one advanceTo, as a run steps
-// from one output time to the next (and LAMMPS runs a window: one `run`). Counters: ns per particle-step, the
-// minimum and the median over the windows.
+// The granular chute of bench/compare_lammps.sh (examples/lammps_chute3d.toml, lammps_chute2d.toml: the LAMMPS
+// flowing state), one thread, timed in short windows of steps. The machine is shared and its speed changes within
+// a minute; the fastest window is what the code costs when nothing else runs, so two builds compare by their
+// minima (and, less sharply, their medians) rather than by the time of a whole run. A window is one advanceTo, as
+// a run steps from one output time to the next (and LAMMPS runs a window: one `run`). Counters: ns per
+// particle-step, the minimum and the median over the windows.
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -24,14 +24,15 @@ template <int D>
 void chute(benchmark::State& state) {
     omp_set_num_threads(1);
     const int windows = static_cast<int>(state.range(0)), steps = static_cast<int>(state.range(1));
-    const std::string dir = std::string(HAET_SOURCE_DIR) + "/bench/";
-    const std::string data = dir + (D == 3 ? "data/chute3d.flowing.data" : "data/chute2d.flowing.data");
+    const std::string root = std::string(HAET_SOURCE_DIR) + "/";
+    const std::string data = root + (D == 3 ? "bench/data/chute3d.flowing.data" : "bench/data/chute2d.flowing.data");
     if (!std::filesystem::exists(data)) {
         state.SkipWithError(
             ("no " + data + ": bench/compare_lammps.sh prepares it (make bench runs it first)").c_str());
         return;
     }
-    const haet::Scenario sc = haet::loadScenario(dir + (D == 3 ? "chute3d.toml" : "chute2d.toml"));
+    const haet::Scenario sc =
+        haet::loadScenario(root + (D == 3 ? "examples/lammps_chute3d.toml" : "examples/lammps_chute2d.toml"));
     haet::World<D> w = haet::buildWorld<D>(sc);
     haet::TdmEngine<D> eng(w, haet::tdmSettings<D>(sc, w));
     for (int k = 0; k < steps; ++k) eng.step();  // the first list build and the caches warm

@@ -17,9 +17,9 @@
 
 namespace haet::testing {
 
-/// A scene of tests/data/ (the same files `haet run` accepts).
-inline Scenario dataScenario(const std::string& name) {
-    return loadScenario(std::filesystem::path(HAET_SOURCE_DIR) / "tests" / "data" / name);
+/// A scene of examples/ (the files `haet run` runs), with `overrides` as `haet run --set` takes them.
+inline Scenario exampleScenario(const std::string& name, const std::vector<std::string>& overrides = {}) {
+    return loadScenario(std::filesystem::path(HAET_SOURCE_DIR) / "examples" / name, overrides);
 }
 
 /// Whether two arrays hold the same bits (not only equal values: -0 and 0, NaNs told apart).

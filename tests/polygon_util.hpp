@@ -60,9 +60,9 @@ inline double collisionEnergyChange(std::uint64_t seed, double dtFactor, Polygon
     return energy() / e0 - 1;
 }
 
-/// Energy of the elastic, frictionless polygon gas of tests/data/polygon_gas.toml (120 polygons, Gear5 at the polygon
-/// time step) under the normal law `law`, Young's modulus `young` [N/m] (0: the file's), over `steps` steps. The
-/// energy is read at instants without any contact, where it is purely kinetic.
+/// Energy of the elastic, frictionless polygon gas of examples/elastic_polygon_gas.toml (120 polygons, Gear5 at the
+/// polygon time step) under the normal law `law`, Young's modulus `young` [N/m] (0: the file's), over `steps` steps.
+/// The energy is read at instants without any contact, where it is purely kinetic.
 struct GasEnergy {
     double drift = 0;       ///< largest |E / E0 - 1| over the contact-free instants
     int samples = 0;        ///< contact-free instants
@@ -72,7 +72,7 @@ struct GasEnergy {
 };
 
 inline GasEnergy gasEnergy(PolygonLaw law, int steps, double young = 0) {
-    Scenario sc = dataScenario("polygon_gas.toml");
+    Scenario sc = exampleScenario("elastic_polygon_gas.toml");
     sc.contact.polygonLaw = law;
     if (young > 0) sc.materials[0].young = young;
     World<2> w = buildWorld<2>(sc);

@@ -362,6 +362,41 @@ TEST_F(Cli, RunWritesOutputs) {
     EXPECT_EQ(vtuFiles, 3);
 }
 
+// --set KEY=VALUE: the run takes the value and records it in run.json; `check` prints it; a bad one exits 2 naming
+// the override and the key, for `check` and `run` alike.
+TEST_F(Cli, SetOverridesAValueAndIsRecorded) {
+    const fs::path f = write("tiny.toml", kTiny);
+    const Result c = haet("check '" + f.string() + "' --set tdm.dt=1e-5 --set 'insert[1].count=1'");
+    ASSERT_EQ(c.code, 0) << c.err;
+    EXPECT_NE(c.out.find("dt = 1e-05 s"), std::string::npos) << c.out;
+    EXPECT_NE(c.out.find("set        tdm.dt=1e-5"), std::string::npos) << c.out;
+    const fs::path out = dir_ / "run";
+    const Result r =
+        haet("run -q --set duration=5e-4 '" + f.string() + "' --out '" + out.string() + "' --set tdm.dt=1e-5");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(checkSeries(out / "series.csv"), 6);  // 5e-4 s instead of 1e-3 s, a row every 1e-4 s
+    const std::string json = read(out / "run.json");
+    EXPECT_TRUE(JsonCheck(json).valid()) << json;
+    EXPECT_EQ(jsonString(json, "duration"), "5e-4") << json;
+    EXPECT_EQ(jsonString(json, "tdm.dt"), "1e-5") << json;
+    EXPECT_NE(json.find("\"steps\": 50"), std::string::npos) << json;
+}
+
+TEST_F(Cli, SetWithUnknownKeyOrBadValueIsBadInput) {
+    const fs::path f = write("tiny.toml", kTiny);
+    for (const char* set : {"tdm.dtt=1e-5", "insert[1].count=many", "materials.glass.restitution=2"}) {
+        const std::string key = std::string(set).substr(0, std::string(set).find('='));
+        const std::string where = f.string() + " (--set " + set + "): " + key + ": ";
+        for (const std::string& cmd :
+             {"check '" + f.string() + "'", "run -q '" + f.string() + "' --out '" + (dir_ / "out").string() + "'"}) {
+            const Result r = haet(cmd + " --set '" + set + "'");
+            EXPECT_EQ(r.code, 2) << cmd << " " << set << ": " << r.err;
+            EXPECT_NE(r.err.find(where), std::string::npos) << "expected \"" << where << "\" in: " << r.err;
+        }
+    }
+    EXPECT_FALSE(fs::exists(dir_ / "out" / "run.json")) << "nothing is run on bad input";
+}
+
 // method = "haet": the hybrid's columns in series.csv, the mode field in the snapshots, the zone images, and
 // `haet check` naming the values in force.
 TEST_F(Cli, HybridRunWritesModesZonesAndColumns) {

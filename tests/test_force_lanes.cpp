@@ -1,7 +1,7 @@
 // The force loop's contact law on four touching pairs at once in lanes (core/lanes.hpp) against the same loop
 // evaluating them one by one: the same forces, torques, springs and statistics to the last bit, for every normal
 // law, with one and two threads, in 2D and 3D. The scene is a hot frictional gas of two materials between walls
-// (tests/data/threads*.toml with a second material), stepped a while first so that contacts carry springs and
+// (examples/confined_gas*.toml with a second material), stepped a while first so that contacts carry springs and
 // some slide.
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -27,12 +27,12 @@ namespace {
 using testing::replaced;
 using testing::sameBits;
 
-/// threadsXd.toml with 500 fewer particles, and 500 of a second material (other friction and restitution, other sizes).
-/// dense: the first 2 500 on a square (cubic) lattice of touching disks (spheres), spacing one diameter, under the
-/// hot start, so that most of them touch a neighbour: blocks with many touching pairs (the 2D law takes eight at
-/// a time when a block has them).
+/// confined_gasXd.toml with 500 fewer particles, and 500 of a second material (other friction and restitution, other
+/// sizes). dense: the first 2 500 on a square (cubic) lattice of touching disks (spheres), spacing one diameter, under
+/// the hot start, so that most of them touch a neighbour: blocks with many touching pairs (the 2D law takes eight at a
+/// time when a block has them).
 Scenario twoMaterialGas(const char* name, bool dense = false) {
-    const std::filesystem::path file = std::filesystem::path(HAET_SOURCE_DIR) / "tests" / "data" / name;
+    const std::filesystem::path file = std::filesystem::path(HAET_SOURCE_DIR) / "examples" / name;
     std::ifstream in(file);
     std::stringstream ss;
     ss << in.rdbuf();
@@ -113,47 +113,47 @@ void expectLanesMatchOneByOne(const Scenario& sc, int threads, bool oneLaw = fal
 }
 
 TEST(ForceLanes, LinearSameBitsAsOneByOne3D) {
-    const Scenario sc = twoMaterialGas("threads3d.toml");
+    const Scenario sc = twoMaterialGas("confined_gas3d.toml");
     expectLanesMatchOneByOne<3, LinearNormal>(sc, 1);
     expectLanesMatchOneByOne<3, LinearNormal>(sc, 2);
 }
 
 TEST(ForceLanes, LinearSameBitsAsOneByOne2D) {
-    const Scenario sc = twoMaterialGas("threads2d.toml");
+    const Scenario sc = twoMaterialGas("confined_gas2d.toml");
     expectLanesMatchOneByOne<2, LinearNormal>(sc, 1);
     expectLanesMatchOneByOne<2, LinearNormal>(sc, 2);
 }
 
 TEST(ForceLanes, DensePackingSameBitsAsOneByOne2D) {
-    const Scenario sc = twoMaterialGas("threads2d.toml", true);
+    const Scenario sc = twoMaterialGas("confined_gas2d.toml", true);
     expectLanesMatchOneByOne<2, LinearNormal>(sc, 1, false, 1500);
     expectLanesMatchOneByOne<2, HertzViscoNormal>(sc, 2, false, 1500);
 }
 
 TEST(ForceLanes, DensePackingSameBitsAsOneByOne3D) {
-    const Scenario sc = twoMaterialGas("threads3d.toml", true);
+    const Scenario sc = twoMaterialGas("confined_gas3d.toml", true);
     expectLanesMatchOneByOne<3, LinearNormal>(sc, 1, false, 1000);
     expectLanesMatchOneByOne<3, HertzTsujiNormal>(sc, 2, false, 1000);
 }
 
 TEST(ForceLanes, HertzSameBitsAsOneByOne) {
-    const Scenario s3 = twoMaterialGas("threads3d.toml");
+    const Scenario s3 = twoMaterialGas("confined_gas3d.toml");
     expectLanesMatchOneByOne<3, HertzViscoNormal>(s3, 1);
     expectLanesMatchOneByOne<3, HertzTsujiNormal>(s3, 2);
-    const Scenario s2 = twoMaterialGas("threads2d.toml");
+    const Scenario s2 = twoMaterialGas("confined_gas2d.toml");
     expectLanesMatchOneByOne<2, HertzViscoNormal>(s2, 2);
     expectLanesMatchOneByOne<2, HertzTsujiNormal>(s2, 1);
 }
 
 TEST(ForceLanes, OneLawForAllPairsSameBitsAsOneByOne) {
-    expectLanesMatchOneByOne<3, LinearNormal>(twoMaterialGas("threads3d.toml"), 1, true);
-    expectLanesMatchOneByOne<2, LinearNormal>(twoMaterialGas("threads2d.toml"), 2, true);
+    expectLanesMatchOneByOne<3, LinearNormal>(twoMaterialGas("confined_gas3d.toml"), 1, true);
+    expectLanesMatchOneByOne<2, LinearNormal>(twoMaterialGas("confined_gas2d.toml"), 2, true);
 }
 
 // A non-finite velocity reaches the forces of the particle and its partners in the same evaluation, an infinite
 // position the particle's own test: the pass reports the first particle concerned, in both ways of evaluating.
 TEST(ForceLanes, NonFiniteStateIsReported) {
-    const Scenario sc = twoMaterialGas("threads3d.toml");
+    const Scenario sc = twoMaterialGas("confined_gas3d.toml");
     World<3> w = buildWorld<3>(sc);
     TdmEngine<3> eng(w, tdmSettings<3>(sc, w));
     for (int k = 0; k < 100; ++k) eng.step();

@@ -27,7 +27,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 using testing::coveredFraction;
-using testing::dataScenario;
+using testing::exampleScenario;
 using testing::kineticEnergy;
 using testing::momentum;
 using testing::momentumScale;
@@ -84,7 +84,7 @@ void expectCollisional(const GasResult& r, double stepsPerContact) {
 }
 
 TEST(ElasticGas, Gear5EnergyAndMomentumConserved3D) {
-    const Scenario sc = dataScenario("gas3d.toml");
+    const Scenario sc = exampleScenario("elastic_gas3d.toml");
     ASSERT_EQ(sc.tdm.integrator, IntegratorKind::Gear5);
     const GasResult r = runGas<3>(sc, 10000);
     record("energy_drift", r.maxEnergyDrift);
@@ -94,7 +94,7 @@ TEST(ElasticGas, Gear5EnergyAndMomentumConserved3D) {
 }
 
 TEST(ElasticGas, Gear5EnergyAndMomentumConserved2D) {
-    const Scenario sc = dataScenario("gas2d.toml");
+    const Scenario sc = exampleScenario("elastic_gas2d.toml");
     ASSERT_EQ(sc.tdm.integrator, IntegratorKind::Gear5);
     const GasResult r = runGas<2>(sc, 10000);
     record("energy_drift", r.maxEnergyDrift);
@@ -108,8 +108,8 @@ TEST(ElasticGas, Gear5EnergyAndMomentumConserved2D) {
 // (Angular momentum is not checked: orbital angular momentum is not conserved in a periodic box, and the torque
 // rule tau = -a n x F_t of PHYSICS.md B.4 conserves spin + orbital only up to O(overlap/radius) anyway.)
 TEST(ElasticGas, FrictionalMomentumConserved) {
-    for (const char* file : {"gas3d.toml", "gas2d.toml"}) {
-        Scenario sc = dataScenario(file);
+    for (const char* file : {"elastic_gas3d.toml", "elastic_gas2d.toml"}) {
+        Scenario sc = exampleScenario(file);
         sc.contact.tangential = TangentialLaw::Spring;
         sc.materials[0].friction = 0.5;
         for (IntegratorKind integ : {IntegratorKind::Gear5, IntegratorKind::Verlet}) {
@@ -492,8 +492,24 @@ SettleResult settle(const Scenario& sc) {
     return r;
 }
 
+// The closed boxes of the validation (examples/closed_box*.toml) made smaller: 250 particles for 0.3 s.
+const std::vector<std::string> kSmallClosedBox3d = {"seed=3",
+                                                    "duration=0.3",
+                                                    "domain.hi=[0.012, 0.012, 0.03]",
+                                                    "walls[2].point=[0, 0, 0.03]",
+                                                    "walls[4].point=[0.012, 0, 0]",
+                                                    "walls[6].point=[0, 0.012, 0]",
+                                                    "insert[1].count=250"};
+const std::vector<std::string> kSmallClosedBox2d = {"seed=4",
+                                                    "duration=0.3",
+                                                    "domain.hi=[0.04, 0.06]",
+                                                    "walls[2].point=[0, 0.06]",
+                                                    "walls[4].point=[0.04, 0]",
+                                                    "contact.duration=5e-4",
+                                                    "insert[1].count=250"};
+
 TEST(Settling, SpheresInClosedBox) {
-    const SettleResult r = settle<3>(dataScenario("settle3d_small.toml"));
+    const SettleResult r = settle<3>(exampleScenario("closed_box3d.toml", kSmallClosedBox3d));
     EXPECT_EQ(r.lost, 0u);
     EXPECT_LT(r.kineticRatio, 1e-3);
     EXPECT_GT(r.bulkHeight, 1.5) << "the measured bulk region is too thin";
@@ -502,7 +518,7 @@ TEST(Settling, SpheresInClosedBox) {
 }
 
 TEST(Settling, DisksInClosedBox) {
-    const SettleResult r = settle<2>(dataScenario("settle2d_small.toml"));
+    const SettleResult r = settle<2>(exampleScenario("closed_box2d.toml", kSmallClosedBox2d));
     EXPECT_EQ(r.lost, 0u);
     EXPECT_LT(r.kineticRatio, 1e-3);
     EXPECT_GT(r.bulkHeight, 3.0) << "the measured bulk region is too thin";
@@ -569,7 +585,7 @@ std::uint64_t runHashed(const Scenario& sc, int threads, std::uint64_t* contactS
 class ThreadCount : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(ThreadCount, BitIdenticalWithOneAndTwoThreads) {
-    const Scenario sc = dataScenario(GetParam());
+    const Scenario sc = exampleScenario(GetParam());
     const int before = omp_get_max_threads();
     std::uint64_t c1 = 0, c2 = 0;
     const std::uint64_t h1 = sc.dimension == 3 ? runHashed<3>(sc, 1, &c1) : runHashed<2>(sc, 1, &c1);
@@ -583,7 +599,7 @@ TEST_P(ThreadCount, BitIdenticalWithOneAndTwoThreads) {
 // advanceTo runs velocity Verlet's corrector and the next step's predictor on each block of the force pass:
 // the state is the one of step() after step(), bit for bit, with one and two threads (both scenes with Verlet).
 TEST_P(ThreadCount, StepsInOneCallMatchStepByStep) {
-    Scenario sc = dataScenario(GetParam());
+    Scenario sc = exampleScenario(GetParam());
     sc.tdm.integrator = IntegratorKind::Verlet;
     sc.tdm.integratorGiven = true;
     const int before = omp_get_max_threads();
@@ -597,8 +613,8 @@ TEST_P(ThreadCount, StepsInOneCallMatchStepByStep) {
     omp_set_num_threads(before);
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, ThreadCount, ::testing::Values("threads3d.toml", "threads2d.toml"),
-                         [](const auto& info) { return std::string(info.param).substr(0, 9); });
+INSTANTIATE_TEST_SUITE_P(Scenes, ThreadCount, ::testing::Values("confined_gas3d.toml", "confined_gas2d.toml"),
+                         [](const auto& info) { return std::string(info.param).substr(0, 14); });
 
 }  // namespace
 }  // namespace haet

@@ -323,9 +323,14 @@ TEST(PolygonEnergy, HeadOnFlatCollisionConservesEnergy) {
 // The same column of 120 grains (same sizes: disk radius = polygon circumradius, same material, same release) falls
 // onto a frictional floor. Disks roll: without rolling resistance a disk heap hardly holds a slope. Polygons cannot
 // roll and interlock.
+// The piles of examples/pile2d_*.toml made smaller: 120 grains, a column of 6 x 20 lattice sites, 0.6 s.
+const std::vector<std::string> kSmallPile = {"duration=0.6", "domain.hi=[0.25, 0.12]", "walls[3].point=[0.25, 0.0]",
+                                             "insert[1].count=120",
+                                             "insert[1].region={ lo = [0.113, 0.0], hi = [0.137, 0.085] }"};
+
 TEST(PolygonRepose, PolygonHeapIsSteeperThanDiskHeap) {
-    const double poly = testing::pileAngle(testing::dataScenario("pile2d_small_polygons.toml"));
-    const double disk = testing::pileAngle(testing::dataScenario("pile2d_small_disks.toml"));
+    const double poly = testing::pileAngle(testing::exampleScenario("pile2d_polygons.toml", kSmallPile));
+    const double disk = testing::pileAngle(testing::exampleScenario("pile2d_disks.toml", kSmallPile));
     record("polygon_angle_deg", poly);
     record("disk_angle_deg", disk);
     EXPECT_GT(poly, disk + 5.0) << "polygons " << poly << " deg, disks " << disk << " deg";

@@ -305,6 +305,103 @@ TEST_F(ScenarioTest, HashIsFnv1a64OfTheFileBytes) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
+// Overrides (`haet run --set KEY=VALUE`): a value of the file replaced or added before validation.
+
+TEST_F(ScenarioTest, OverridesChangeValues) {
+    const fs::path p = write("box.toml", kBox3d);
+    const Scenario s =
+        loadScenario(p, {"duration=0.01", "tdm.dt=1e-5", "insert[2].count=500", "seed = 7", "domain.hi=[0.2, 0.1, 0.3]",
+                         "materials.brass.friction=0.1", "insert[1].region={ lo = [0, 0, 0], hi = [0.1, 0.1, 0.06] }",
+                         "method=edm", "edm.cell_size=0.003", "walls[1].point[3]=0.01", "duration=0.02"});
+    EXPECT_DOUBLE_EQ(s.duration, 0.02);  // the later of two overrides of one key
+    EXPECT_DOUBLE_EQ(*s.tdm.dt, 1e-5);
+    EXPECT_EQ(s.inserts[1].count, 500u);
+    EXPECT_EQ(s.inserts[0].count, 100u);
+    EXPECT_EQ(s.seed, 7u);
+    EXPECT_EQ(s.domain.hi, (Vec3d{0.2, 0.1, 0.3}));
+    EXPECT_DOUBLE_EQ(s.materials[1].friction, 0.1);
+    EXPECT_DOUBLE_EQ(s.materials[0].friction, 0.5);
+    EXPECT_EQ(s.inserts[0].regionHi, (Vec3d{0.1, 0.1, 0.06}));
+    EXPECT_EQ(s.method, Method::Edm);  // a bare word is a string
+    EXPECT_DOUBLE_EQ(*s.edm.cellSize, 0.003);
+    EXPECT_DOUBLE_EQ(s.walls[0].point[2], 0.01);
+    EXPECT_EQ(s.hash, fnv1a64Hex(kBox3d));  // the file's hash; the overrides are recorded beside it
+    const std::vector<std::string> applied = {"tdm.dt=1e-5",
+                                              "insert[2].count=500",
+                                              "seed=7",
+                                              "domain.hi=[0.2, 0.1, 0.3]",
+                                              "materials.brass.friction=0.1",
+                                              "insert[1].region={ lo = [0, 0, 0], hi = [0.1, 0.1, 0.06] }",
+                                              "method=edm",
+                                              "edm.cell_size=0.003",
+                                              "walls[1].point[3]=0.01",
+                                              "duration=0.02"};
+    EXPECT_EQ(s.overrides, applied);
+    EXPECT_TRUE(loadScenario(p).overrides.empty());
+}
+
+TEST_F(ScenarioTest, OverrideAddsATableTheFileLacks) {
+    const fs::path p = write("box.toml", kBox3d);
+    const Scenario s = loadScenario(p, {"haet.phi_on=0.5", "method=\"haet\""});
+    EXPECT_EQ(s.method, Method::Haet);
+    EXPECT_DOUBLE_EQ(*s.haet.phiOn, 0.5);
+}
+
+TEST_F(ScenarioTest, OverrideFilePathIsRelativeToTheWorkingDirectory) {
+    const std::string csv = "x,y,z,radius\n0.05,0.05,0.01,0.001\n";
+    write("grains.csv", csv);
+    fs::create_directories(dir_ / "scenes");
+    const std::string text =
+        kBox3d + "\n[[insert]]\narrangement = \"file\"\nfile = \"elsewhere.csv\"\nmaterial = \"glass\"\n";
+    const fs::path p = write("scenes/box.toml", text);
+    const fs::path cwd = fs::current_path();
+    fs::current_path(dir_);
+    Scenario s;
+    try {
+        s = loadScenario(p, {"insert[3].file=\"grains.csv\""});
+    } catch (...) {
+        fs::current_path(cwd);
+        throw;
+    }
+    fs::current_path(cwd);
+    ASSERT_EQ(s.inserts.size(), 3u);
+    EXPECT_EQ(fs::path(s.inserts[2].file), dir_ / "grains.csv");
+}
+
+/// Loads kBox3d with `override` expecting a ScenarioError that names the override and `key`.
+void expectOverrideError(const fs::path& p, const std::string& override, const std::string& key) {
+    try {
+        loadScenario(p, {override});
+        ADD_FAILURE() << "no ScenarioError for --set " << override;
+    } catch (const ScenarioError& e) {
+        const std::string msg = e.what();
+        EXPECT_EQ(e.pos().file, p.string() + " (--set " + override + ")") << msg;
+        EXPECT_EQ(e.key(), key) << msg;
+        EXPECT_EQ(msg.rfind(p.string() + " (--set " + override + "): " + (key.empty() ? "" : key + ": "), 0), 0u)
+            << msg;
+    }
+}
+
+TEST_F(ScenarioTest, OverrideErrorsNameTheOverrideAndTheKey) {
+    const fs::path p = write("box.toml", kBox3d);
+    expectOverrideError(p, "tdm.dtt=1e-5", "tdm.dtt");  // unknown key
+    expectOverrideError(p, "colour=1", "colour");       // unknown key at the top
+    expectOverrideError(p, "materials.glass.colour=1", "materials.glass.colour");
+    expectOverrideError(p, "insert[2].count=abc", "insert[2].count");  // bad value (a string)
+    expectOverrideError(p, "insert[2].count=-5", "insert[2].count");   // bad value (out of range)
+    expectOverrideError(p, "duration=[1, 2]", "duration");             // bad type
+    expectOverrideError(p, "materials.glass.restitution=1.5", "materials.glass.restitution");
+    expectOverrideError(p, "insert[3].count=5", "insert[3]");                              // no such element
+    expectOverrideError(p, "walls.point=[0, 0, 1]", "walls");                              // an array, not a table
+    expectOverrideError(p, "duration.x=1", "duration");                                    // a value has no keys
+    expectOverrideError(p, "duration=1 2", "duration");                                    // not TOML
+    expectOverrideError(p, "duration=", "duration");                                       // no value
+    expectOverrideError(p, "insert[0].count=5", "insert[0].count");                        // 1-based
+    expectOverrideError(p, "duration", "");                                                // no '='
+    expectOverrideError(p, "insert[2].region={ lo = [0, 0, 0] }", "insert[2].region.hi");  // inside a table value
+}
+
+// ---------------------------------------------------------------------------------------------------------------
 // Bad input: one test per kind; each checks file name, line and key in the message.
 
 TEST_F(ScenarioTest, ErrorUnknownKey) {

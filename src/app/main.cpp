@@ -4,6 +4,8 @@
 
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "core/version.hpp"
 #include "io/atomic_file.hpp"
@@ -23,17 +25,30 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
 
     std::string runFile, outDir;
+    std::vector<std::string> sets;  // --set KEY=VALUE of `run` or `check`, in order
     int threads = 0;
     bool quiet = false;
+    const std::string setHelp =
+        "override a value of the scenario, KEY=VALUE with a TOML value (tdm.dt=1e-5, insert[2].count=500); "
+        "repeatable";
     auto* run = app.add_subcommand("run", "run a scenario and write its outputs");
     run->add_option("scenario", runFile, "scenario file (TOML)")->required();
     run->add_option("--out", outDir, "output directory (default: [output] directory of the scenario)");
     run->add_option("--threads", threads, "number of threads (default: all cores)")->check(CLI::NonNegativeNumber);
     run->add_flag("--quiet,-q", quiet, "no progress bar or summary");
+    // One value per --set, so that the scenario may follow it.
+    run->add_option("--set", sets, setHelp)
+        ->expected(1)
+        ->allow_extra_args(false)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 
     std::string checkFile;
     auto* check = app.add_subcommand("check", "validate a scenario and print what it would run");
     check->add_option("scenario", checkFile, "scenario file (TOML)")->required();
+    check->add_option("--set", sets, setHelp)
+        ->expected(1)
+        ->allow_extra_args(false)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 
     std::string plotFile, plotOut, plotX = "time", plotTitle;
     std::vector<std::string> plotY;
@@ -56,7 +71,7 @@ int main(int argc, char** argv) {
 
     try {
         if (*run) {
-            const haet::Scenario sc = haet::loadScenario(runFile);
+            const haet::Scenario sc = haet::loadScenario(runFile, sets);
             haet::RunOptions opt{outDir, threads, quiet};
             return static_cast<int>(haet::runScenario(sc, opt, std::cerr));
         }
@@ -80,8 +95,9 @@ int main(int argc, char** argv) {
                                    plotY.size() == 1 ? plotY[0] : std::string(), series, o);
             return 0;
         }
-        const haet::Scenario sc = haet::loadScenario(checkFile);
+        const haet::Scenario sc = haet::loadScenario(checkFile, sets);
         haet::describeScenario(sc, std::cout);
+        for (const std::string& o : sc.overrides) std::cout << "set        " << o << "\n";
         std::cout << "ok\n";
         return 0;
     } catch (const haet::ScenarioError& e) {

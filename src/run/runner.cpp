@@ -470,6 +470,11 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         j.add("scenario", sc.path);
         j.add("scenario_name", sc.name);
         j.add("scenario_hash", sc.hash);
+        if (!sc.overrides.empty()) {  // --set KEY=VALUE, applied to the file in this order
+            JsonObject o;
+            for (const std::string& kv : sc.overrides) o.add(kv.substr(0, kv.find('=')), kv.substr(kv.find('=') + 1));
+            j.add("overrides", o);
+        }
         j.add("method", eng->method());
         j.add("dimension", static_cast<std::int64_t>(D));
         j.add("status", status);

@@ -153,7 +153,8 @@ struct Scenario {
     std::vector<WallDef> walls;
     std::vector<InsertDef> inserts;
     OutputDef output;
-    std::string hash;  ///< hash of the file contents (hex)
+    std::string hash;                    ///< hash of the file contents (hex)
+    std::vector<std::string> overrides;  ///< command-line overrides applied to the file, "KEY=VALUE" (loader.hpp)
 };
 
 }  // namespace haet

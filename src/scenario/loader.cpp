@@ -34,10 +34,15 @@ public:
     std::string keyPath(std::string_view key) const {
         return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
     }
-    SourcePos tablePos() const { return {file_, int(table_.source().begin.line)}; }
+    SourcePos tablePos() const { return posOfNode(table_); }
     SourcePos posOf(std::string_view key) const {
-        if (const toml::node* n = table_.get(key)) return {file_, int(n->source().begin.line)};
+        if (const toml::node* n = table_.get(key)) return posOfNode(*n);
         return tablePos();
+    }
+    /// Whether the value of `key` was given on the command line (`--set`), not in the file.
+    bool fromOverride(std::string_view key) const {
+        const toml::node* n = table_.get(key);
+        return n && n->source().path && *n->source().path != file_;
     }
     bool has(std::string_view key) const { return table_.contains(key); }
 
@@ -48,12 +53,21 @@ public:
 
     /// Rejects any key not in `allowed`; reports the first one in file order so the message is stable.
     void allowOnly(std::initializer_list<std::string_view> allowed) const {
+        // An override's key comes first (its value holds the override's name), then the file's in line order.
         const toml::key* first = nullptr;
+        auto before = [&](const toml::key& a, const toml::key& b) {
+            const bool oa = fromOverride(a.str()), ob = fromOverride(b.str());
+            return oa != ob ? oa : a.source().begin.line < b.source().begin.line;
+        };
         for (auto&& [k, v] : table_) {
             if (std::find(allowed.begin(), allowed.end(), std::string_view(k.str())) != allowed.end()) continue;
-            if (!first || k.source().begin.line < first->source().begin.line) first = &k;
+            if (!first || before(k, *first)) first = &k;
         }
-        if (first) throw ScenarioError({file_, int(first->source().begin.line)}, keyPath(first->str()), "unknown key");
+        if (first) {
+            const SourcePos pos =
+                fromOverride(first->str()) ? posOf(first->str()) : SourcePos{file_, int(first->source().begin.line)};
+            throw ScenarioError(pos, keyPath(first->str()), "unknown key");
+        }
     }
 
     /// Rejects `key` when present: it does not apply in this configuration (`why` says which one would need it).
@@ -183,6 +197,14 @@ public:
     }
 
 private:
+    /// A value of the file by its line; one set on the command line by the override that set it (its TOML source
+    /// is named "--set KEY=VALUE", applyOverride).
+    SourcePos posOfNode(const toml::node& n) const {
+        const auto& src = n.source();
+        if (src.path && *src.path != file_) return {file_ + " (" + *src.path + ")", 0};
+        return {file_, int(src.begin.line)};
+    }
+
     static std::optional<double> asNumber(const toml::node& n) {
         if (const auto* i = n.as_integer()) return double(i->get());
         if (const auto* f = n.as_floating_point()) return f->get();
@@ -508,7 +530,8 @@ private:
             const std::string name = r.requiredString("file");
             if (name.empty()) r.fail("file", "must not be empty");
             std::filesystem::path p(name);
-            if (p.is_relative()) p = dir_ / p;
+            // A file named on the command line is where the command was typed, as any path on a command line.
+            if (p.is_relative()) p = (r.fromOverride("file") ? std::filesystem::current_path() : dir_) / p;
             std::error_code ec;
             if (!std::filesystem::is_regular_file(p, ec)) r.fail("file", "file not found: " + p.string());
             in.file = p.string();
@@ -676,6 +699,120 @@ private:
     bool needDiskLaw_ = false;
 };
 
+// ---- Overrides: `--set KEY=VALUE` on the command line (docs/scenario.md, "Overrides") ----------------------------
+// An override replaces (or adds) one value of the parsed file before the Loader reads it, so it is validated by the
+// same code as a value of the file and its errors name the key the same way. Its value keeps the TOML source name
+// "--set KEY=VALUE", which is how TableReader::posOfNode tells it from the file's values.
+
+std::string trimmed(std::string_view s) {
+    const auto isSpace = [](char c) { return c == ' ' || c == '\t'; };
+    while (!s.empty() && isSpace(s.front())) s.remove_prefix(1);
+    while (!s.empty() && isSpace(s.back())) s.remove_suffix(1);
+    return std::string(s);
+}
+
+bool isBareKeyChar(char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+}
+
+/// One step of a key path: a table's key, and for an array the 1-based index of its element (0: none).
+struct KeyStep {
+    std::string name;
+    std::size_t index = 0;
+};
+
+/// "insert[2].region.lo" -> {insert, 2}, {region}, {lo}; nullopt when malformed.
+std::optional<std::vector<KeyStep>> parseKeyPath(std::string_view key) {
+    std::vector<KeyStep> steps;
+    std::size_t i = 0;
+    while (true) {
+        KeyStep step;
+        while (i < key.size() && isBareKeyChar(key[i])) step.name += key[i++];
+        if (step.name.empty()) return std::nullopt;
+        if (i < key.size() && key[i] == '[') {
+            const std::size_t close = key.find(']', i);
+            if (close == std::string_view::npos || close == i + 1 || close - i > 10) return std::nullopt;
+            for (std::size_t k = i + 1; k < close; ++k) {
+                if (key[k] < '0' || key[k] > '9') return std::nullopt;
+                step.index = step.index * 10 + std::size_t(key[k] - '0');
+            }
+            if (step.index == 0) return std::nullopt;
+            i = close + 1;
+        }
+        steps.push_back(std::move(step));
+        if (i == key.size()) return steps;
+        if (key[i] != '.') return std::nullopt;
+        ++i;
+    }
+}
+
+/// Applies one override to the parsed file `root`; returns "KEY=VALUE" as it was applied (blanks around '=' and the
+/// ends trimmed). A value that is not TOML but a bare word (letters, digits, '_', '-') is taken as a string, so that
+/// `method=edm` needs no quotes that the shell would remove.
+std::string applyOverride(toml::table& root, const std::string& text, const std::string& file) {
+    const std::string source = "--set " + text;
+    const SourcePos pos{file + " (" + source + ")", 0};
+    const std::size_t eq = text.find('=');
+    if (eq == std::string::npos) throw ScenarioError(pos, "", "expected KEY=VALUE");
+    const std::string key = trimmed(std::string_view(text).substr(0, eq));
+    const std::string value = trimmed(std::string_view(text).substr(eq + 1));
+    const auto steps = parseKeyPath(key);
+    if (!steps)
+        throw ScenarioError(pos, key,
+                            "not a key path (dotted keys, an array's element by its 1-based index: insert[2].count)");
+    if (value.empty()) throw ScenarioError(pos, key, "no value after '='");
+
+    toml::table parsed;
+    try {
+        parsed = toml::parse("value = " + value + "\n", std::string_view(source));
+    } catch (const toml::parse_error&) {
+        if (!std::all_of(value.begin(), value.end(), isBareKeyChar))
+            throw ScenarioError(pos, key,
+                                "the value is not in TOML syntax (a number, true/false, \"text\", [a, b], "
+                                "{ k = v })");
+        parsed = toml::parse("value = \"" + value + "\"\n", std::string_view(source));
+    }
+
+    // Walk to the table that holds the last key; tables that the file does not have are made.
+    toml::table* t = &root;
+    std::string done;  // the key path walked so far, written as the loader writes keys
+    auto stepName = [](const KeyStep& s) { return s.index ? s.name + "[" + std::to_string(s.index) + "]" : s.name; };
+    auto element = [&](toml::node* n, const KeyStep& s) -> toml::node* {
+        toml::array* a = n ? n->as_array() : nullptr;
+        const std::string here = done.empty() ? s.name : done + "." + s.name;
+        if (!a)
+            throw ScenarioError(pos, here,
+                                n ? "not an array: it has no element " + std::to_string(s.index)
+                                  : "not in the file: there is no element to set");
+        if (s.index > a->size())
+            throw ScenarioError(pos, here + "[" + std::to_string(s.index) + "]",
+                                "no such element: the file has " + std::to_string(a->size()));
+        return a->get(s.index - 1);
+    };
+    for (std::size_t k = 0; k + 1 < steps->size(); ++k) {
+        const KeyStep& s = (*steps)[k];
+        toml::node* n = t->get(s.name);
+        if (s.index) {
+            n = element(n, s);
+        } else if (!n) {
+            n = t->insert(s.name, toml::table{}).first->second.as_table();
+        }
+        done += (done.empty() ? "" : ".") + stepName(s);
+        t = n->as_table();
+        if (!t) throw ScenarioError(pos, done, "not a table: a value has no keys");
+    }
+    const KeyStep& last = steps->back();
+    toml::node& v = *parsed.get("value");
+    if (last.index) {
+        element(t->get(last.name), last);  // checks that there is such an element
+        toml::array& a = *t->get(last.name)->as_array();
+        v.visit([&](auto& x) { a.replace(a.cbegin() + std::ptrdiff_t(last.index - 1), std::move(x)); });
+    } else {
+        v.visit([&](auto& x) { t->insert_or_assign(last.name, std::move(x)); });
+    }
+    return key + "=" + value;
+}
+
 }  // namespace
 
 std::string fnv1a64Hex(std::string_view bytes) {
@@ -690,7 +827,8 @@ std::string fnv1a64Hex(std::string_view bytes) {
     return out;
 }
 
-Scenario parseScenario(std::string_view text, const std::filesystem::path& file) {
+Scenario parseScenario(std::string_view text, const std::filesystem::path& file,
+                       const std::vector<std::string>& overrides) {
     const std::string name = file.string();
     toml::table root;
     try {
@@ -699,16 +837,25 @@ Scenario parseScenario(std::string_view text, const std::filesystem::path& file)
         throw ScenarioError({name, int(e.source().begin.line)}, "",
                             "TOML syntax error: " + std::string(e.description()));
     }
+    std::vector<std::string> applied;
+    for (const std::string& o : overrides) {
+        const std::string a = applyOverride(root, o, name);
+        // A later override of the same key replaces the earlier one, in the record as in the scene.
+        const std::string key = a.substr(0, a.find('='));
+        std::erase_if(applied, [&](const std::string& b) { return b.compare(0, key.size() + 1, key + "=") == 0; });
+        applied.push_back(a);
+    }
     Scenario s = Loader(root, name, file.parent_path()).load();
     s.hash = fnv1a64Hex(text);
+    s.overrides = std::move(applied);
     return s;
 }
 
-Scenario loadScenario(const std::filesystem::path& file) {
+Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw ScenarioError({file.string(), 0}, "", "cannot open the scenario file");
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    return parseScenario(text, file);
+    return parseScenario(text, file, overrides);
 }
 
 }  // namespace haet

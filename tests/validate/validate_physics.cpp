@@ -1,6 +1,6 @@
 // Long physics validations of the time-driven engine (`make validate`, label "validate"): the 10^5-step versions
 // of the conservation and settling checks whose short versions are in tests/test_physics.cpp. Same scenes
-// (tests/data/), same criteria.
+// (examples/), same criteria.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,7 +21,7 @@ namespace haet {
 namespace {
 
 using testing::coveredFraction;
-using testing::dataScenario;
+using testing::exampleScenario;
 using testing::kineticEnergy;
 using testing::momentum;
 using testing::momentumScale;
@@ -31,7 +31,7 @@ using testing::record;
 
 template <int D>
 void elasticGas(const char* file) {
-    const Scenario sc = dataScenario(file);
+    const Scenario sc = exampleScenario(file);
     ASSERT_EQ(sc.tdm.integrator, IntegratorKind::Gear5);
     World<D> w = buildWorld<D>(sc);
     TdmEngine<D> eng(w, tdmSettings<D>(sc, w));
@@ -54,8 +54,8 @@ void elasticGas(const char* file) {
     EXPECT_LT(dp, 1e-12);
 }
 
-TEST(ValidateElasticGas, Gear5Conserves3D) { elasticGas<3>("gas3d.toml"); }
-TEST(ValidateElasticGas, Gear5Conserves2D) { elasticGas<2>("gas2d.toml"); }
+TEST(ValidateElasticGas, Gear5Conserves3D) { elasticGas<3>("elastic_gas3d.toml"); }
+TEST(ValidateElasticGas, Gear5Conserves2D) { elasticGas<2>("elastic_gas2d.toml"); }
 
 // ---- settling of ~500 spheres / disks in a closed box ----
 
@@ -63,7 +63,7 @@ TEST(ValidateElasticGas, Gear5Conserves2D) { elasticGas<2>("gas2d.toml"); }
 /// packing fraction (one diameter from side walls and floor, 1.5 diameters below the highest centre) in range.
 template <int D>
 void settle(const char* file, double kineticMax, double packMin, double packMax) {
-    const Scenario sc = dataScenario(file);
+    const Scenario sc = exampleScenario(file);
     World<D> w = buildWorld<D>(sc);
     const std::size_t n0 = w.particles.size();
     TdmEngine<D> eng(w, tdmSettings<D>(sc, w));
@@ -98,8 +98,8 @@ void settle(const char* file, double kineticMax, double packMin, double packMax)
     EXPECT_LE(packing, packMax);
 }
 
-TEST(ValidateSettling, SpheresInClosedBox) { settle<3>("settle3d.toml", 1e-4, 0.55, 0.66); }
-TEST(ValidateSettling, DisksInClosedBox) { settle<2>("settle2d.toml", 1e-4, 0.78, 0.86); }
+TEST(ValidateSettling, SpheresInClosedBox) { settle<3>("closed_box3d.toml", 1e-4, 0.55, 0.66); }
+TEST(ValidateSettling, DisksInClosedBox) { settle<2>("closed_box2d.toml", 1e-4, 0.78, 0.86); }
 
 }  // namespace
 }  // namespace haet

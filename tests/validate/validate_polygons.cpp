@@ -20,7 +20,7 @@
 namespace haet {
 namespace {
 
-using testing::dataScenario;
+using testing::exampleScenario;
 using testing::record;
 
 // Gear at the polygon time step against a 16 times smaller step, over 200 random collisions: the energy after a
@@ -83,8 +83,8 @@ TEST(PolygonEnergyLong, OverlapAreaLawEnergyChangeShrinksWithStiffness) {
     EXPECT_LT(previous, first / 10) << "1e7 against 1e4";
 }
 
-// An elastic, frictionless gas of 120 polygons (tests/data/polygon_gas.toml), 10^5 Gear5 steps at the polygon time
-// step, Y = 1e4 N/m (overlaps up to a few % of the size). The energy is read at instants without any contact,
+// An elastic, frictionless gas of 120 polygons (examples/elastic_polygon_gas.toml), 10^5 Gear5 steps at the polygon
+// time step, Y = 1e4 N/m (overlaps up to a few % of the size). The energy is read at instants without any contact,
 // where it is purely kinetic. With the potential law (polygon_law = "potential") the drift stays within the 1e-3
 // goal: the law conserves energy, what remains is Gear's error at each contact onset. The overlap-area law of
 // PHYSICS.md G.3 is not conservative (a collision with spin or an offset approach changes the pair's energy by
