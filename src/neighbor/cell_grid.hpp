@@ -7,9 +7,9 @@
 //
 // Codes. The 3^D cells around cell c are numbered by an offset code q in base 3, axis 0 the lowest digit, digit k
 // = o[k] + 1 for the offset o[k] in {-1, 0, 1} along axis k; q = kCentre is the cell itself. A neighbour reached
-// across a periodic face is given with its image code, digit k = image[k] + 1: its members, as stored in the box,
-// sit image[k] box lengths away from where they neighbour c, so x_member + image L is their position next to c.
-// The image code of a neighbour reached inside the box is kCentre.
+// across a periodic face is given with its image code, digit k = image[k] + 1: a member stored at x in the box
+// neighbours c at x + image[k] L along axis k (image -1 across the lower face, +1 across the upper one). The
+// image code of a neighbour reached inside the box is kCentre.
 #include <algorithm>
 #include <array>
 #include <cmath>
