@@ -92,7 +92,7 @@ void sortIntoCells(const Particles<D>& p, const CellGrid<D>& g, std::vector<std:
 
 template <int D>
 std::vector<Vec<D>> makeShiftVectors(const Domain<D>& dom) {
-    constexpr int m = (D == 2) ? 9 : 27;
+    constexpr int m = CellGrid<D>::kStencil;
     std::vector<Vec<D>> sv(m);
     for (int code = 0; code < m; ++code) {
         const std::array<int, D> s = CellGrid<D>::offsetsOf(code);
@@ -373,7 +373,6 @@ template <int D>
 void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s,
                    const std::vector<std::uint32_t>& from, PairList<D>& list, const Vec<D>* ref) {
     constexpr std::uint32_t kNone = 0xFFFFFFFFu;
-    constexpr std::uint8_t kMirror = (D == 2) ? 8 : 26;  // shift code of (j, i) = kMirror - code of (i, j)
     const std::size_t n = from.size();
     const std::size_t nOld = list.first.empty() ? 0 : list.first.size() - 1;
     std::vector<std::uint32_t> inv(nOld, kNone);
@@ -409,8 +408,8 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 const Vec<D> h = list.history.empty() ? Vec<D>::zero() : list.history[k];
                 if (a < b)
                     entries.push_back({a, b, list.shift[k], h});
-                else
-                    entries.push_back({b, a, static_cast<std::uint8_t>(kMirror - list.shift[k]), -h});
+                else  // the shift of (j, i) is minus that of (i, j): the mirror code
+                    entries.push_back({b, a, static_cast<std::uint8_t>(CellGrid<D>::mirror(list.shift[k])), -h});
             }
         }
     }
