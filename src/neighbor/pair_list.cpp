@@ -73,6 +73,13 @@ struct CellNeighbours {
     }
 };
 
+/// The distinct neighbour cells of the cell of x, for remapPairList's grid path (rare). Out of line: inlined, the
+/// walk made the compiler spend more instructions on remapPairList's loops over partners.
+template <int D>
+[[gnu::noinline]] int neighbourCells(const CellGrid<D>& g, const Vec<D>& x, int* cells) {
+    return g.distinctNeighbours(g.coordsOf(x), cells);
+}
+
 /// Particles sorted by cell: cellStart (size total+1) and the particle indices in cell order.
 template <int D>
 void sortIntoCells(const Particles<D>& p, const CellGrid<D>& g, std::vector<std::uint32_t>& cellStart,
@@ -446,7 +453,7 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
         sortIntoCells(p, g, cellStart, members, cellOf);
         for (const std::uint32_t f : freshList) {
             int cells[27];
-            const int nc = g.distinctNeighbours(g.coordsOf(p.x[f]), cells);
+            const int nc = neighbourCells(g, p.x[f], cells);
             for (int q = 0; q < nc; ++q)
                 for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) consider(f, members[a]);
         }
