@@ -172,7 +172,7 @@ void HaetEngine<D>::bin(const Vec<D>& x, double r) {
     bins_.push_back(Binned{x, r, binHead_[c], kNil});
     binHead_[c] = b;
     if (near_.valid) {
-        const std::size_t idx = nearIndex(nearCoord(x));
+        const int idx = near_.grid.wrappedCellOf(x);
         bins_[b].nextNear = near_.head[idx];
         near_.head[idx] = b;
     }
@@ -192,23 +192,6 @@ void HaetEngine<D>::markAround(std::uint32_t cell, std::uint8_t level) {
 }
 
 template <int D>
-std::array<int, D> HaetEngine<D>::nearCoord(const Vec<D>& x) const {
-    std::array<int, D> c;
-    for (int k = 0; k < D; ++k) {
-        const int q = static_cast<int>(std::floor((x[k] - near_.lo[k]) * near_.invWidth[k]));
-        c[k] = w_.domain.periodic[k] ? ((q % near_.n[k]) + near_.n[k]) % near_.n[k] : std::clamp(q, 0, near_.n[k] - 1);
-    }
-    return c;
-}
-
-template <int D>
-std::size_t HaetEngine<D>::nearIndex(const std::array<int, D>& c) const {
-    std::size_t idx = 0;
-    for (int k = D - 1; k >= 0; --k) idx = idx * static_cast<std::size_t>(near_.n[k]) + static_cast<std::size_t>(c[k]);
-    return idx;
-}
-
-template <int D>
 void HaetEngine<D>::buildNearGrid() {
     const double edge = 2 * rmax_ + margin_;
     Vec<D> a = Vec<D>::filled(std::numeric_limits<double>::max()),
@@ -220,30 +203,31 @@ void HaetEngine<D>::buildNearGrid() {
         }
     // At most max(4096, 4 bins) cells: a few far-flung TDM particles give larger cells, not a huge grid.
     const double maxCells = std::max(4096.0, 4.0 * static_cast<double>(bins_.size()));
+    std::array<int, D> n{};
+    Vec<D> lo, width;
     for (double h = edge;; h *= 1.25) {
         double total = 1;
         for (int k = 0; k < D; ++k) {
-            if (w_.domain.periodic[k]) {
+            if (w_.domain.periodic[k]) {  // whole cells over the box
                 const double L = w_.domain.hi[k] - w_.domain.lo[k];
-                near_.n[k] = std::max(1, static_cast<int>(std::floor(L / h)));
-                near_.lo[k] = w_.domain.lo[k];
-                near_.invWidth[k] = near_.n[k] / L;
-            } else {
+                n[k] = std::max(1, static_cast<int>(std::floor(L / h)));
+                lo[k] = w_.domain.lo[k];
+                width[k] = L / n[k];
+            } else {  // cells of edge h over the bins
                 const double span = bins_.empty() ? 0.0 : b[k] - a[k];
-                near_.n[k] = std::max(1, static_cast<int>(std::ceil(span / h)));
-                near_.lo[k] = bins_.empty() ? 0.0 : a[k];
-                near_.invWidth[k] = 1 / h;
+                n[k] = std::max(1, static_cast<int>(std::ceil(span / h)));
+                lo[k] = bins_.empty() ? 0.0 : a[k];
+                width[k] = h;
             }
-            total *= near_.n[k];
+            total *= n[k];
         }
         if (total <= maxCells) break;
     }
-    std::size_t total = 1;
-    for (int k = 0; k < D; ++k) total *= static_cast<std::size_t>(near_.n[k]);
-    near_.head.assign(total, kNil);
+    near_.grid = CellGrid<D>(lo, n, width, w_.domain.periodic);
+    near_.head.assign(static_cast<std::size_t>(near_.grid.count()), kNil);
     near_.valid = true;
     for (std::uint32_t i = 0; i < bins_.size(); ++i) {
-        const std::size_t idx = nearIndex(nearCoord(bins_[i].x));
+        const int idx = near_.grid.wrappedCellOf(bins_[i].x);
         bins_[i].nextNear = near_.head[idx];
         near_.head[idx] = i;
     }
@@ -260,39 +244,18 @@ double HaetEngine<D>::gapToTdm(const Vec<D>& x, double r, double* bound) const {
     double lowest = kNever;
     if (bound) {
         double width = kNever;
-        for (int k = 0; k < D; ++k) width = std::min(width, 1 / near_.invWidth[k]);
+        for (int k = 0; k < D; ++k) width = std::min(width, near_.grid.width()[k]);
         lowest = width - r - rmax_;
     }
-    const Vec<D> L = w_.domain.length();
-    const std::array<int, D> c = nearCoord(x);
-    constexpr int m = D == 2 ? 9 : 27;
-    for (int code = 0; code < m; ++code) {
-        bool inside = true;
-        int t = code;
-        std::array<int, D> cc;
-        for (int k = 0; k < D; ++k) {
-            int ck = c[k] + t % 3 - 1;
-            t /= 3;
-            if (ck < 0 || ck >= near_.n[k]) {
-                if (!w_.domain.periodic[k]) {
-                    inside = false;
-                    break;
-                }
-                ck = (ck + near_.n[k]) % near_.n[k];
-            }
-            cc[k] = ck;
-        }
-        if (!inside) continue;
-        // A periodic axis of one or two cells visits a cell more than once: harmless for a minimum.
-        for (std::uint32_t b = near_.head[nearIndex(cc)]; b != kNil; b = bins_[b].nextNear) {
-            Vec<D> d = x - bins_[b].x;
-            for (int k = 0; k < D; ++k)
-                if (w_.domain.periodic[k]) d[k] -= std::nearbyint(d[k] / L[k]) * L[k];
+    // A periodic axis of one or two cells visits a cell more than once: harmless for a minimum.
+    near_.grid.forEachNeighbour(near_.grid.wrappedCoordsOf(x), [&](int cell, int) {
+        for (std::uint32_t b = near_.head[cell]; b != kNil; b = bins_[b].nextNear) {
+            const Vec<D> d = w_.domain.minimumImage(x - bins_[b].x);
             const double reach = r + bins_[b].r + margin_, d2 = norm2(d);
             if (d2 < reach * reach && d2 > 0) gap = std::min(gap, std::sqrt(d2) - r - bins_[b].r);
             if (bound && d2 > 0) lowest = std::min(lowest, std::sqrt(d2) - r - bins_[b].r);
         }
-    }
+    });
     if (bound) *bound = lowest;
     return gap;
 }

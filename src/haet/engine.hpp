@@ -14,6 +14,7 @@
 
 #include "edm/engine.hpp"
 #include "haet/zones.hpp"
+#include "neighbor/cell_grid.hpp"
 #include "tdm/engine.hpp"
 #include "world/world.hpp"
 
@@ -99,15 +100,12 @@ private:
     /// cells may be much larger. Open axes span the binned particles (others fall into the outer cells),
     /// periodic ones the box.
     struct NearGrid {
-        std::array<int, D> n{};
-        Vec<D> lo, invWidth;
+        CellGrid<D> grid;  // points beyond a periodic face wrap, beyond an open one they fall into the outer cells
         std::vector<std::uint32_t> head;
         bool valid = false;
     };
     /// The near grid over the current bins, with every bin in it; later bins go in as they come.
     void buildNearGrid();
-    std::array<int, D> nearCoord(const Vec<D>& x) const;
-    std::size_t nearIndex(const std::array<int, D>& c) const;
     /// The guard and bins from the current TDM positions; on due steps also the zone labels and the mode changes
     /// they imply (urgent hand-overs always).
     void relabel(std::vector<std::uint32_t> arrivals, bool due);

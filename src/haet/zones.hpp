@@ -8,6 +8,7 @@
 
 #include "core/particles.hpp"
 #include "geometry/domain.hpp"
+#include "neighbor/cell_grid.hpp"
 
 namespace haet {
 
@@ -23,9 +24,13 @@ class ZoneGrid {
 public:
     ZoneGrid(const Domain<D>& dom, const ZoneSettings& s);
 
-    int count() const { return total_; }
-    const std::array<int, D>& dims() const { return n_; }
-    int zoneOf(const Vec<D>& x) const;
+    int count() const { return grid_.count(); }
+    const std::array<int, D>& dims() const { return grid_.dims(); }
+    /// The zones as cells (zone index = cell index).
+    const CellGrid<D>& grid() const { return grid_; }
+    /// The zone of x; beyond a periodic face x is wrapped into the box, beyond an open one it falls into the
+    /// outer zones.
+    int zoneOf(const Vec<D>& x) const { return grid_.wrappedCellOf(x); }
 
     /// Recomputes the volume fraction of every zone from the particles (centres in the zone), smooths it over
     /// the zone and its neighbours, and updates the labels with hysteresis. sticky[z] != 0 keeps zone z dense.
@@ -33,11 +38,7 @@ public:
     /// The same from the particle volume per zone [m^D] (size count()), when the caller keeps it current.
     void relabel(const std::vector<double>& volume, const std::vector<std::uint8_t>& sticky);
     /// Index stride of axis k: zone index = sum of coordinate k * stride(k).
-    int stride(int k) const {
-        int m = 1;
-        for (int q = 0; q < k; ++q) m *= n_[q];
-        return m;
-    }
+    int stride(int k) const { return grid_.stride(k); }
 
     /// Dense zone (before the buffer).
     bool dense(int z) const { return dense_[z]; }
@@ -47,8 +48,8 @@ public:
     double smoothed(int z) const { return phiSmooth_[z]; }  ///< smoothed fraction of zone z
     std::size_t changedLast() const { return changed_; }  ///< zones whose timeDriven label changed in the last relabel
     double zoneVolume() const { return cellVolume_; }
-    Vec<D> zoneWidth() const { return width_; }
-    Vec<D> origin() const { return lo_; }
+    Vec<D> zoneWidth() const { return grid_.width(); }
+    Vec<D> origin() const { return grid_.origin(); }
 
 private:
     /// out[z] = op over the zones within `radius` of z along axis k (periodic axes wrap, each zone once; open
@@ -57,10 +58,7 @@ private:
     void alongAxis(int k, int radius, const std::vector<T>& in, std::vector<T>& out, Op op) const;
 
     ZoneSettings s_;
-    std::array<int, D> n_{};
-    std::array<bool, D> periodic_{};
-    Vec<D> lo_, width_;
-    int total_ = 1;
+    CellGrid<D> grid_;
     double cellVolume_ = 1;
     std::vector<double> phi_, phiSmooth_;
     std::vector<std::uint8_t> dense_, tdm_;

@@ -6,88 +6,29 @@
 #include <cmath>
 #include <numeric>
 
+#include "neighbor/cell_grid.hpp"
+
 namespace haet {
 namespace {
 
+/// The pair list's grid: over the box on periodic axes and over the particles [0, tdmCount()) on open ones (a
+/// hybrid run's time-driven particles may fill a small part of a tall box), cells no narrower than cellSize.
 template <int D>
-struct Grid {
-    std::array<int, D> n{};
-    Vec<D> lo, width;
-    int total = 1;
-
-    /// A grid over the box on periodic axes and over the particles [0, tdmCount()) on open ones: a hybrid run's
-    /// time-driven particles may fill a small part of a tall box.
-    Grid(const Domain<D>& dom, double cellSize, const Particles<D>& p) {
-        Vec<D> hi = dom.hi;
-        lo = dom.lo;
-        const std::size_t np = p.tdmCount();
-        for (int k = 0; k < D; ++k) {
-            if (dom.periodic[k] || np == 0) continue;
-            double a = p.x[0][k], b = a;
-            for (std::size_t i = 1; i < np; ++i) {
-                a = std::min(a, p.x[i][k]);
-                b = std::max(b, p.x[i][k]);
-            }
-            // Within the box: particles beyond it (an open axis) fall into the outer cells, as before.
-            lo[k] = std::clamp(a, dom.lo[k], dom.hi[k]);
-            hi[k] = std::max(std::clamp(b, dom.lo[k], dom.hi[k]), lo[k] + cellSize);
+CellGrid<D> pairGrid(const Domain<D>& dom, double cellSize, const Particles<D>& p) {
+    Vec<D> lo = dom.lo, hi = dom.hi;
+    const std::size_t np = p.tdmCount();
+    for (int k = 0; k < D; ++k) {
+        if (dom.periodic[k] || np == 0) continue;
+        double a = p.x[0][k], b = a;
+        for (std::size_t i = 1; i < np; ++i) {
+            a = std::min(a, p.x[i][k]);
+            b = std::max(b, p.x[i][k]);
         }
-        for (int k = 0; k < D; ++k) {
-            const double L = hi[k] - lo[k];
-            n[k] = std::max(1, static_cast<int>(std::floor(L / cellSize)));
-            width[k] = L / n[k];
-            total *= n[k];
-        }
+        // Within the box: particles beyond it (an open axis) fall into the outer cells, as before.
+        lo[k] = std::clamp(a, dom.lo[k], dom.hi[k]);
+        hi[k] = std::max(std::clamp(b, dom.lo[k], dom.hi[k]), lo[k] + cellSize);
     }
-    int coord(const Vec<D>& x, int k) const {
-        const int c = static_cast<int>(std::floor((x[k] - lo[k]) / width[k]));
-        return std::clamp(c, 0, n[k] - 1);
-    }
-    int index(const std::array<int, D>& c) const {
-        int idx = 0;
-        for (int k = D - 1; k >= 0; --k) idx = idx * n[k] + c[k];
-        return idx;
-    }
-    int cellOf(const Vec<D>& x) const {
-        std::array<int, D> c;
-        for (int k = 0; k < D; ++k) c[k] = coord(x, k);
-        return index(c);
-    }
-};
-
-/// The cell of x and its neighbours, de-duplicated (a periodic axis with fewer than 3 cells maps offsets
-/// together), in increasing order. Returns their number (at most 3^D).
-template <int D>
-int neighbourCellsOf(const Grid<D>& g, const Domain<D>& dom, const std::array<int, D>& c, int* cells) {
-    int nc = 0;
-    constexpr int m = (D == 2) ? 9 : 27;
-    for (int code = 0; code < m; ++code) {
-        std::array<int, D> cc;
-        bool ok = true;
-        int t = code;
-        for (int k = 0; k < D; ++k) {
-            int ck = c[k] + (t % 3) - 1;
-            t /= 3;
-            if (ck < 0 || ck >= g.n[k]) {
-                if (!dom.periodic[k]) {
-                    ok = false;
-                    break;
-                }
-                ck = (ck + g.n[k]) % g.n[k];
-            }
-            cc[k] = ck;
-        }
-        if (ok) cells[nc++] = g.index(cc);
-    }
-    std::sort(cells, cells + nc);
-    return static_cast<int>(std::unique(cells, cells + nc) - cells);
-}
-
-template <int D>
-int neighbourCells(const Grid<D>& g, const Domain<D>& dom, const Vec<D>& x, int* cells) {
-    std::array<int, D> c;
-    for (int k = 0; k < D; ++k) c[k] = g.coord(x, k);
-    return neighbourCellsOf<D>(g, dom, c, cells);
+    return CellGrid<D>::spanning(lo, hi, cellSize, dom.periodic);
 }
 
 /// The neighbour cells of a cell, each with the image-shift code of its particles, computed for one cell at a
@@ -95,8 +36,8 @@ int neighbourCells(const Grid<D>& g, const Domain<D>& dom, const Vec<D>& x, int*
 /// once; a table for the whole grid would hold 27 entries per occupied cell, megabytes at the rebuild's peak).
 /// When every periodic axis has at least 3 cells (each no narrower than the cutoff), a neighbour cell reached
 /// across a periodic face holds only images shifted by one box length, and the code is exact. Otherwise offsets
-/// fold onto the same cell (neighbourCells de-duplicates them) and the code is kAnyShift: the pair test finds the
-/// minimum image itself. One per thread.
+/// fold onto the same cell (CellGrid::distinctNeighbours de-duplicates them) and the code is kAnyShift: the pair
+/// test finds the minimum image itself. One per thread.
 template <int D>
 struct CellNeighbours {
     static constexpr std::uint8_t kAnyShift = 0xFF;
@@ -104,90 +45,53 @@ struct CellNeighbours {
         int cell;
         std::uint8_t code;
     };
-    const Grid<D>* g;
-    const Domain<D>* dom;
+    const CellGrid<D>* g;
     bool exact;
     int cell = -1;  ///< the cell whose neighbours list holds
     int count = 0;
     Entry list[27];
-    int delta[27];  ///< index offsets of the neighbours of a cell away from the grid's faces, in offset order
 
-    CellNeighbours(const Grid<D>& grid, const Domain<D>& domain) : g(&grid), dom(&domain), exact(true) {
-        for (int k = 0; k < D; ++k) exact = exact && (!domain.periodic[k] || grid.n[k] >= 3);
-        constexpr int m = (D == 2) ? 9 : 27;
-        for (int offset = 0; offset < m; ++offset) {
-            int u = offset, stride = 1;
-            delta[offset] = 0;
-            for (int k = 0; k < D; ++k) {
-                delta[offset] += (u % 3 - 1) * stride;
-                u /= 3;
-                stride *= grid.n[k];
-            }
-        }
-    }
+    explicit CellNeighbours(const CellGrid<D>& grid) : g(&grid), exact(grid.imagesExact()) {}
 
     /// Makes list[0, count) the neighbours of cell c.
     void of(int c) {
         if (c == cell) return;
         cell = c;
-        std::array<int, D> cc;
-        int t = c;
-        for (int k = 0; k < D; ++k) {  // Grid::index is x fastest
-            cc[k] = t % g->n[k];
-            t /= g->n[k];
-        }
-        count = 0;
-        constexpr int m = (D == 2) ? 9 : 27;
-        bool interior = exact;
-        for (int k = 0; k < D; ++k) interior = interior && cc[k] >= 1 && cc[k] <= g->n[k] - 2;
-        if (interior) {  // no face crossed: every image shift is zero (code 13 in 3D, 4 in 2D)
-            constexpr std::uint8_t kNone = (D == 2) ? 4 : 13;
-            for (int offset = 0; offset < m; ++offset) list[offset] = {c + delta[offset], kNone};
-            count = m;
-            return;
-        }
+        const std::array<int, D> cc = g->coords(c);
+        int nc = 0;
         if (!exact) {
             int cells[27];
-            const int nc = neighbourCellsOf<D>(*g, *dom, cc, cells);
-            for (int q = 0; q < nc; ++q) list[count++] = {cells[q], kAnyShift};
-            return;
+            const int nd = g->distinctNeighbours(cc, cells);
+            for (int q = 0; q < nd; ++q) list[nc++] = {cells[q], kAnyShift};
+        } else {
+            // d = x_i - x_j + shift L with x_j seen at x_j + image L: the shift is -image, its code the mirror.
+            g->forEachNeighbour(cc, [&](int idx, int image) {
+                list[nc++] = {idx, static_cast<std::uint8_t>(CellGrid<D>::mirror(image))};
+            });
         }
-        for (int offset = 0; offset < m; ++offset) {
-            std::array<int, D> nc;
-            int u = offset, code = 0, mul = 1;
-            bool inside = true;
-            for (int k = 0; k < D && inside; ++k) {
-                nc[k] = cc[k] + u % 3 - 1;
-                u /= 3;
-                int shift = 0;  // d = x_i - x_j + shift L: +1 for an image to the left of the box
-                if (nc[k] < 0) {
-                    nc[k] += g->n[k];
-                    shift = 1;
-                } else if (nc[k] >= g->n[k]) {
-                    nc[k] -= g->n[k];
-                    shift = -1;
-                }
-                inside = shift == 0 || dom->periodic[k];
-                code += (shift + 1) * mul;
-                mul *= 3;
-            }
-            if (inside) list[count++] = {g->index(nc), static_cast<std::uint8_t>(code)};
-        }
+        count = nc;
     }
 };
 
+/// The distinct neighbour cells of the cell of x, for remapPairList's grid path (rare). Out of line: inlined, the
+/// walk made the compiler spend more instructions on remapPairList's loops over partners.
+template <int D>
+[[gnu::noinline]] int neighbourCells(const CellGrid<D>& g, const Vec<D>& x, int* cells) {
+    return g.distinctNeighbours(g.coordsOf(x), cells);
+}
+
 /// Particles sorted by cell: cellStart (size total+1) and the particle indices in cell order.
 template <int D>
-void sortIntoCells(const Particles<D>& p, const Grid<D>& g, std::vector<std::uint32_t>& cellStart,
+void sortIntoCells(const Particles<D>& p, const CellGrid<D>& g, std::vector<std::uint32_t>& cellStart,
                    std::vector<std::uint32_t>& members, std::vector<int>& cellOf) {
     const std::size_t n = p.tdmCount();
     cellOf.resize(n);
-    cellStart.assign(g.total + 1, 0);
+    cellStart.assign(g.count() + 1, 0);
     for (std::size_t i = 0; i < n; ++i) {
         cellOf[i] = g.cellOf(p.x[i]);
         ++cellStart[cellOf[i] + 1];
     }
-    for (int c = 0; c < g.total; ++c) cellStart[c + 1] += cellStart[c];
+    for (int c = 0, nc = g.count(); c < nc; ++c) cellStart[c + 1] += cellStart[c];
     members.resize(n);
     std::vector<std::uint32_t> fill(cellStart.begin(), cellStart.end() - 1);
     for (std::size_t i = 0; i < n; ++i) members[fill[cellOf[i]]++] = static_cast<std::uint32_t>(i);
@@ -195,15 +99,11 @@ void sortIntoCells(const Particles<D>& p, const Grid<D>& g, std::vector<std::uin
 
 template <int D>
 std::vector<Vec<D>> makeShiftVectors(const Domain<D>& dom) {
-    constexpr int m = (D == 2) ? 9 : 27;
+    constexpr int m = CellGrid<D>::kStencil;
     std::vector<Vec<D>> sv(m);
     for (int code = 0; code < m; ++code) {
-        int c = code;
-        for (int k = 0; k < D; ++k) {
-            const int s = c % 3 - 1;
-            c /= 3;
-            sv[code][k] = s * (dom.hi[k] - dom.lo[k]);
-        }
+        const std::array<int, D> s = CellGrid<D>::offsetsOf(code);
+        for (int k = 0; k < D; ++k) sv[code][k] = s[k] * (dom.hi[k] - dom.lo[k]);
     }
     return sv;
 }
@@ -213,6 +113,7 @@ template <int D>
 inline bool testPair(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, std::uint32_t i,
                      std::uint32_t j, std::uint8_t& code, double extra = 0) {
     if (s.excludeFrozenPairs && (p.flags[i] & p.flags[j] & kFrozen)) return false;
+    // Domain::minimumImage, keeping the number of box lengths added for the shift code.
     Vec<D> d = p.x[i] - p.x[j];
     int cd = 0, mul = 1;
     for (int k = 0; k < D; ++k) {
@@ -343,13 +244,13 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
     }
     double rmax = 0;
     for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
-    const Grid<D> g(dom, std::max(2 * rmax + s.skin, 1e-300), p);
+    const CellGrid<D> g = pairGrid(dom, std::max(2 * rmax + s.skin, 1e-300), p);
     std::vector<std::uint32_t> cellStart, members;
     std::vector<int> cellOf;
     sortIntoCells(p, g, cellStart, members, cellOf);
     out.shiftVec = makeShiftVectors(dom);
 
-    std::vector<CellNeighbours<D>> nbs(static_cast<std::size_t>(omp_get_max_threads()), CellNeighbours<D>(g, dom));
+    std::vector<CellNeighbours<D>> nbs(static_cast<std::size_t>(omp_get_max_threads()), CellNeighbours<D>(g));
     // A cell's members are in increasing index order: the partners j > i of each cell start after i.
     auto candidates = [&](std::size_t i, auto&& add) {
         CellNeighbours<D>& nb = nbs[static_cast<std::size_t>(omp_get_thread_num())];
@@ -468,7 +369,7 @@ void buildAllPairs(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
 template <int D>
 std::vector<std::uint32_t> spatialOrder(const Particles<D>& p, const Domain<D>& dom, double cellSize) {
     if (p.tdmCount() == 0) return {};
-    const Grid<D> g(dom, cellSize, p);
+    const CellGrid<D> g = pairGrid(dom, cellSize, p);
     std::vector<std::uint32_t> cellStart, members;
     std::vector<int> cellOf;
     sortIntoCells(p, g, cellStart, members, cellOf);
@@ -479,7 +380,6 @@ template <int D>
 void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s,
                    const std::vector<std::uint32_t>& from, PairList<D>& list, const Vec<D>* ref) {
     constexpr std::uint32_t kNone = 0xFFFFFFFFu;
-    constexpr std::uint8_t kMirror = (D == 2) ? 8 : 26;  // shift code of (j, i) = kMirror - code of (i, j)
     const std::size_t n = from.size();
     const std::size_t nOld = list.first.empty() ? 0 : list.first.size() - 1;
     std::vector<std::uint32_t> inv(nOld, kNone);
@@ -515,8 +415,8 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
                 const Vec<D> h = list.history.empty() ? Vec<D>::zero() : list.history[k];
                 if (a < b)
                     entries.push_back({a, b, list.shift[k], h});
-                else
-                    entries.push_back({b, a, static_cast<std::uint8_t>(kMirror - list.shift[k]), -h});
+                else  // the shift of (j, i) is minus that of (i, j): the mirror code
+                    entries.push_back({b, a, static_cast<std::uint8_t>(CellGrid<D>::mirror(list.shift[k])), -h});
             }
         }
     }
@@ -547,13 +447,13 @@ void remapPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
         for (const std::uint32_t f : freshList)
             for (std::uint32_t j = 0; j < n; ++j) consider(f, j);
     } else if (!freshList.empty()) {
-        const Grid<D> g(dom, std::max(reach, 1e-300), p);
+        const CellGrid<D> g = pairGrid(dom, std::max(reach, 1e-300), p);
         std::vector<std::uint32_t> cellStart, members;
         std::vector<int> cellOf;
         sortIntoCells(p, g, cellStart, members, cellOf);
         for (const std::uint32_t f : freshList) {
             int cells[27];
-            const int nc = neighbourCells(g, dom, p.x[f], cells);
+            const int nc = neighbourCells(g, p.x[f], cells);
             for (int q = 0; q < nc; ++q)
                 for (std::uint32_t a = cellStart[cells[q]]; a < cellStart[cells[q] + 1]; ++a) consider(f, members[a]);
         }

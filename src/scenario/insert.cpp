@@ -14,6 +14,7 @@
 #include <string_view>
 
 #include "core/polygon_shape.hpp"
+#include "neighbor/cell_grid.hpp"
 #include "scenario/text.hpp"
 
 namespace haet {
@@ -121,25 +122,23 @@ class OverlapGrid {
 public:
     /// Box [lo, hi]; `maxRadius` bounds every radius that will be added or tested [m]; `expected` is the number of
     /// particles that will be added, used to keep the cell count proportional to it.
-    OverlapGrid(const Vec<D>& lo, const Vec<D>& hi, double maxRadius, std::size_t expected) : lo_(lo) {
-        cell_ = 2 * maxRadius;
+    OverlapGrid(const Vec<D>& lo, const Vec<D>& hi, double maxRadius, std::size_t expected) {
+        double cell = 2 * maxRadius;
         const double cap = std::max(4096.0, std::min(8.0 * double(expected), double(1u << 22)));
         auto cellCount = [&](double c) {
             double n = 1;
             for (int k = 0; k < D; ++k) n *= std::max(1.0, std::ceil((hi[k] - lo[k]) / c));
             return n;
         };
-        while (cellCount(cell_) > cap) cell_ *= 1.5;
-        std::size_t total = 1;
-        for (int k = 0; k < D; ++k) {
-            n_[k] = std::max(1, int(std::ceil((hi[k] - lo[k]) / cell_)));
-            total *= std::size_t(n_[k]);
-        }
-        head_.assign(total, kNone);
+        while (cellCount(cell) > cap) cell *= 1.5;
+        std::array<int, D> n;
+        for (int k = 0; k < D; ++k) n[k] = std::max(1, int(std::ceil((hi[k] - lo[k]) / cell)));
+        grid_ = CellGrid<D>(lo, n, Vec<D>::filled(cell), std::array<bool, D>{});
+        head_.assign(std::size_t(grid_.count()), kNone);
     }
 
     void add(const Vec<D>& x, double r) {
-        const std::size_t c = cellOf(x);
+        const std::size_t c = std::size_t(grid_.cellOf(x));
         x_.push_back(x);
         r_.push_back(r);
         next_.push_back(head_[c]);
@@ -147,49 +146,21 @@ public:
     }
 
     bool overlaps(const Vec<D>& x, double r) const {
-        std::array<int, D> base;
-        for (int k = 0; k < D; ++k) base[k] = indexOf(x, k);
-        std::array<int, D> off;
-        off.fill(-1);
-        while (true) {
-            std::size_t c = 0;
-            bool inside = true;
-            for (int k = D - 1; k >= 0; --k) {
-                const int i = base[k] + off[k];
-                if (i < 0 || i >= n_[k]) inside = false;
-                c = c * std::size_t(n_[k]) + std::size_t(std::max(0, i));
+        return grid_.forEachNeighbour(grid_.coordsOf(x), [&](int c, int) {
+            for (std::uint32_t j = head_[std::size_t(c)]; j != kNone; j = next_[j]) {
+                const double reach = r + r_[j];
+                // Touching (distance equal to the sum of radii, up to rounding) is allowed: a lattice of
+                // spacing 2r touches exactly.
+                if (norm2(x - x_[j]) < reach * reach * (1 - 1e-12)) return true;
             }
-            if (inside) {
-                for (std::uint32_t j = head_[c]; j != kNone; j = next_[j]) {
-                    const double reach = r + r_[j];
-                    // Touching (distance equal to the sum of radii, up to rounding) is allowed: a lattice of
-                    // spacing 2r touches exactly.
-                    if (norm2(x - x_[j]) < reach * reach * (1 - 1e-12)) return true;
-                }
-            }
-            int k = 0;
-            while (k < D && off[k] == 1) off[k++] = -1;
-            if (k == D) return false;
-            ++off[k];
-        }
+            return false;
+        });
     }
 
 private:
     static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
-    int indexOf(const Vec<D>& x, int k) const {
-        const double f = std::floor((x[k] - lo_[k]) / cell_);
-        return int(std::clamp(f, 0.0, double(n_[k] - 1)));
-    }
-    std::size_t cellOf(const Vec<D>& x) const {
-        std::size_t c = 0;
-        for (int k = D - 1; k >= 0; --k) c = c * std::size_t(n_[k]) + std::size_t(indexOf(x, k));
-        return c;
-    }
-
-    Vec<D> lo_;
-    double cell_;
-    std::array<int, D> n_{};
+    CellGrid<D> grid_;  // open on every axis
     std::vector<std::uint32_t> head_;
     std::vector<std::uint32_t> next_;
     std::vector<Vec<D>> x_;
