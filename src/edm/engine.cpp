@@ -255,12 +255,20 @@ void EdmEngine<D>::reportAll() {
 // ---------------------------------------------------------------------------------------------------------------
 // predictions
 
+// The two broad phases' predictions are separate functions, so that neither shares registers and stack with the
+// other's inlined scan.
 template <int D>
 void EdmEngine<D>::predict(std::uint32_t s, double now, int axis, int dir) {
-    if (shells_.on())
-        predictWith(shells_, s, now, -1, 0);
-    else
-        predictWith(grid_, s, now, axis, dir);
+    if (shells_.on()) {
+        predictShells(s, now);
+        return;
+    }
+    predictWith(grid_, s, now, axis, dir);
+}
+
+template <int D>
+void EdmEngine<D>::predictShells(std::uint32_t s, double now) {
+    predictWith(shells_, s, now, -1, 0);
 }
 
 // Predicts the next event of slot s at time now: the earliest of its exit (from its cell or its shell), its wall
@@ -289,17 +297,10 @@ template <class Broad>
             if (best.better(t, code)) best = {t, code, 0};
         }
     }
-    const edm::ScanState<D> sc = edm::scanState(sl_, hs);
-    std::uint32_t bestJ = kNil;
-    auto four = [&](const edm::Batch<D>& bt, std::uint32_t wsPacked, const Shift* plainBase) {
-        edm::candidates4(sl_, sc, hs, s, bt, wsPacked, plainBase, now, best, bestJ);
-    };
-    if constexpr (std::is_same_v<Broad, edm::EventGrid<D>>)
-        broad.forEachBatch(sl_, at, s, ws, axis, dir, four);
-    else
-        broad.forEachBatch(sl_, s, ws, four);
-    if (bestJ != kNil) best.stamp = sl_.link[bestJ].count;
-    setPending(s, best, cross);
+    edm::Scanner<D> scan{sl_, hs, edm::scanState(sl_, hs), s, now, best, kNil};
+    broad.forEachBatch(sl_, at, s, ws, axis, dir, scan);
+    if (scan.bestJ != kNil) scan.best.stamp = sl_.link[scan.bestJ].count;
+    setPending(s, scan.best, cross);
 }
 
 template <int D>
@@ -397,7 +398,7 @@ void EdmEngine<D>::processNext() {
             if (shells_.on()) {
                 ++stats_.shellExits;
                 if (shells_.move(sl_, grid_, s, t)) ++stats_.listGrowths;
-                predictWith(shells_, s, t, -1, 0);
+                predictShells(s, t);
                 return;
             }
             ++stats_.cellCrossings;

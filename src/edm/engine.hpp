@@ -57,7 +57,7 @@ struct EdmSettings {
     /// engine holds the only copy of positions, velocities and radii. advanceEvents releases the World's
     /// (Particles::releaseMotion) and synchronise writes them back; reset() needs them back first. The engine then
     /// keeps no World-to-slot table: the questions about single particles (owns, add, remove, swapIndices,
-    /// positionAt, velocityAt, collisionCount, cellOfParticle) are the hybrid's, and unavailable.
+    /// positionAt, velocityAt, collisionCount) are the hybrid's, and unavailable.
     bool holdState = false;
     /// World index of the first particle this engine owns. Those before it belong to another engine (the
     /// time-driven one of a hybrid run) and are invisible here; particles join and leave with add() and remove().
@@ -187,6 +187,7 @@ private:
     /// The same with a given broad phase (edm::EventGrid or edm::Shells): one body for both.
     template <class Broad>
     [[gnu::always_inline]] inline void predictWith(const Broad& broad, std::uint32_t s, double now, int axis, int dir);
+    [[gnu::noinline]] void predictShells(std::uint32_t s, double now);
     void setPending(std::uint32_t s, const Candidate& best, const Candidate& cross);
     bool keepsColl(std::uint32_t s) const;
     double keptTime(std::uint32_t s, double now) const;

@@ -152,4 +152,22 @@ template <int D>
     }
 }
 
+/// A scan of slot s at time now: the batches a broad phase names go to candidates4, which keeps the best event in
+/// best (bestJ: the slot of a pair event in it). Its call is inlined where the broad phase makes it, so a batch costs
+/// no call, and the scan's state is one object, reached as directly as the scanning loop's own variables.
+template <int D>
+struct Scanner {
+    const Slots<D>& sl;
+    const typename Slots<D>::Hot& hs;
+    ScanState<D> sc;
+    std::uint32_t s;
+    double now;
+    Candidate best;
+    std::uint32_t bestJ;
+    [[gnu::always_inline]] inline void operator()(const Batch<D>& bt, std::uint32_t wsPacked,
+                                                  const typename Slots<D>::Shift* plainBase) {
+        candidates4(sl, sc, hs, s, bt, wsPacked, plainBase, now, best, bestJ);
+    }
+};
+
 }  // namespace haet::edm

@@ -91,9 +91,11 @@ public:
         return cross;
     }
     /// Calls four(batch, plain wraps, plain base) for the partners of s's list, four at a time, the last batch
-    /// padded with repeats of its first; the image of a list entry is a base per entry.
+    /// padded with repeats of its first; the image of a list entry is a base per entry. A list holds every partner
+    /// that can reach s before it leaves its cube, so there are no partial scans (axis, dir unused).
     template <class F>
-    [[gnu::always_inline]] inline void forEachBatch(const Sl& sl, std::uint32_t s, const Shift& ws, F&& four) const {
+    [[gnu::always_inline]] inline void forEachBatch(const Sl& sl, const Where&, std::uint32_t s, const Shift& ws,
+                                                    int /*axis*/, int /*dir*/, F&& four) const {
         const std::uint32_t* a = row(s);
         const std::uint32_t count = a[0];
         const std::uint32_t zeroWraps = Sl::packWraps(Shift{});
