@@ -297,7 +297,7 @@ template <class Broad>
             if (best.better(t, code)) best = {t, code, 0};
         }
     }
-    edm::Scanner<D> scan{sl_, hs, edm::scanState(sl_, hs), s, now, best, kNil};
+    edm::Scanner<D> scan(sl_, hs, s, now, best);
     broad.forEachBatch(sl_, at, s, ws, axis, dir, scan);
     if (scan.bestJ != kNil) scan.best.stamp = sl_.link[scan.bestJ].count;
     setPending(s, scan.best, cross);

@@ -157,6 +157,11 @@ template <int D>
 /// no call, and the scan's state is one object, reached as directly as the scanning loop's own variables.
 template <int D>
 struct Scanner {
+    // A constructor, not aggregate initialisation: GCC clears a whole aggregate (the lanes of sc too) before it
+    // fills it.
+    Scanner(const Slots<D>& sl_, const typename Slots<D>::Hot& hs_, std::uint32_t s_, double now_,
+            const Candidate& best_)
+        : sl(sl_), hs(hs_), sc(scanState(sl_, hs_)), s(s_), now(now_), best(best_), bestJ(kNil) {}
     const Slots<D>& sl;
     const typename Slots<D>::Hot& hs;
     ScanState<D> sc;
