@@ -42,6 +42,7 @@ void EdmBook<D>::grow(std::uint32_t i) {
     if (i < cell_.size()) return;
     cell_.resize(i + 1, kNone);
     next_.resize(i + 1, kNone);
+    zone_.resize(i + 1, 0);
 }
 
 template <int D>
@@ -67,8 +68,10 @@ void EdmBook<D>::unlink(std::uint32_t i) {
 
 template <int D>
 void EdmBook<D>::joined(std::uint32_t i, std::uint32_t cell, double r) {
-    volume_[zoneOfCell(cell)] += Particles<D>::volumeOf(r);
+    const std::uint32_t z = zoneOfCell(cell);
+    volume_[z] += Particles<D>::volumeOf(r);
     link(i, cell);
+    zone_[i] = z;
 }
 
 template <int D>
@@ -78,8 +81,8 @@ void EdmBook<D>::left(std::uint32_t i, std::uint32_t cell, double r) {
 }
 
 template <int D>
-void EdmBook<D>::crossed(std::uint32_t i, std::uint32_t from, std::uint32_t to, double r) {
-    const std::uint32_t za = zoneOfCell(from), zb = zoneOfCell(to);
+void EdmBook<D>::crossed(std::uint32_t i, std::uint32_t /*from*/, std::uint32_t to, double r) {
+    const std::uint32_t za = zone_[i], zb = zoneOfCell(to);  // za: the zone of the cell left
     if (za != zb) {
         const double vol = Particles<D>::volumeOf(r);
         volume_[za] -= vol;
@@ -88,6 +91,7 @@ void EdmBook<D>::crossed(std::uint32_t i, std::uint32_t from, std::uint32_t to, 
     if (guard_[to]) guardEntries_.push_back(i);
     unlink(i);
     link(i, to);
+    zone_[i] = zb;
 }
 
 // Both pointers are found before either is written, so two neighbours in one list swap places correctly.
@@ -101,6 +105,7 @@ void EdmBook<D>::swapped(std::uint32_t i, std::uint32_t j) {
     if (pj) *pj = i;
     std::swap(next_[i], next_[j]);
     std::swap(cell_[i], cell_[j]);
+    std::swap(zone_[i], zone_[j]);
 }
 
 template <int D>

@@ -63,8 +63,9 @@ private:
     std::array<std::vector<std::uint32_t>, D> zoneCoord_;  // per axis and cell coordinate: zone coordinate
     std::array<std::vector<std::uint32_t>, D> zoneCellBegin_;
     std::vector<double> volume_;
-    // Occupants: per cell the first, per World index the next in its cell and its cell (kNone: not event-driven).
-    std::vector<std::uint32_t> head_, next_, cell_;
+    // Occupants: per cell the first, per World index the next in its cell, its cell (kNone: not event-driven) and
+    // that cell's zone (a crossing then looks up the zone of the new cell only).
+    std::vector<std::uint32_t> head_, next_, cell_, zone_;
     std::vector<std::uint32_t> guardEntries_, tcHandovers_;
 };
 
