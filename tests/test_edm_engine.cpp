@@ -590,10 +590,14 @@ TEST(EdmEngine, RejectsBadSettings) {
     EXPECT_THROW({ EdmEngine<3> e(w, s); }, std::invalid_argument);
     s.cellSize = 0;
     EdmEngine<3> withShells(w, s);
-    std::vector<std::uint8_t> guard(withShells.cellCount(), 0);
-    EdmZoneLink<3> link;
-    link.guard = &guard;
-    EXPECT_THROW(withShells.attachZones(link), std::logic_error);  // zones follow cell crossings
+    struct Silent final : EdmObserver<3> {
+        void restart(const EventCells<3>&) override {}
+        void joined(std::uint32_t, std::uint32_t, double) override {}
+        void left(std::uint32_t, std::uint32_t, double) override {}
+        void crossed(std::uint32_t, std::uint32_t, std::uint32_t, double) override {}
+        void tcCollision(std::uint32_t) override {}
+    } observer;
+    EXPECT_THROW({ EdmEngine<3> e(w, s, &observer); }, std::logic_error);  // an observer follows cell crossings
 }
 
 }  // namespace

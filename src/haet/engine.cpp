@@ -33,7 +33,7 @@ HaetSettings resolved(const World<D>& w, HaetSettings hs) {
 
 template <int D>
 HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings edm, const HaetSettings& hs)
-    : w_(world), ts_(tdm), hs_(resolved(world, hs)), zones_(world.domain, hs_.zones) {
+    : w_(world), ts_(tdm), hs_(resolved(world, hs)), zones_(world.domain, hs_.zones), book_(zones_, guard_) {
     Particles<D>& p = w_.particles;
     const std::size_t n = p.size();
     const double rmax = largestRadius(p);
@@ -60,28 +60,11 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
     edm.tcModel = true;
     if (!(edm.cellSize > 0)) edm.cellSize = eventCellEdge(nT);
     edm.cellSize = std::max(edm.cellSize, 2 * rmax + ts_.skin);
-    edm_ = std::make_unique<EdmEngine<D>>(w_, edm);
-    const std::array<int, D>& nc = edm_->cellDims();
-    EdmZoneLink<D> link;
-    guard_.assign(edm_->cellCount(), 0);
-    binHead_.assign(edm_->cellCount(), kNil);
-    link.guard = &guard_;
-    link.zones = static_cast<std::size_t>(zones_.count());
-    for (int k = 0; k < D; ++k) {
-        const int nz = zones_.dims()[k];
-        link.zoneStride[k] = static_cast<std::uint32_t>(zones_.stride(k));
-        link.zoneCoord[k].resize(nc[k]);
-        zoneCellBegin_[k].assign(nz + 1, static_cast<std::uint32_t>(nc[k]));
-        for (int c = nc[k]; c-- > 0;) {
-            const double xc = (c + 0.5) * edm_->cellWidths()[k];
-            const int z = std::clamp(static_cast<int>(std::floor(xc / zones_.zoneWidth()[k])), 0, nz - 1);
-            link.zoneCoord[k][c] = static_cast<std::uint32_t>(z);
-            zoneCellBegin_[k][z] = static_cast<std::uint32_t>(c);
-        }
-        // Zones holding no cell centre (a zone narrower than a cell): an empty range.
-        for (int z = nz; z-- > 0;) zoneCellBegin_[k][z] = std::min(zoneCellBegin_[k][z], zoneCellBegin_[k][z + 1]);
-    }
-    edm_->attachZones(link);
+    // The engine tells the book its grid and every particle's cell (EdmObserver): zone volumes, occupants, guard
+    // entries and TC hand-overs are the book's from then on.
+    edm_ = std::make_unique<EdmEngine<D>>(w_, edm, &book_);
+    guard_.assign(book_.cells().count(), 0);
+    binHead_.assign(book_.cells().count(), kNil);
     tdm_ = std::make_unique<TdmEngine<D>>(w_, ts_);
     margin_ = std::max(ts_.skin, 0.1 * rmax);
     rmax_ = rmax;
@@ -130,14 +113,14 @@ void HaetEngine<D>::step() {
     tdm_->step();
     ++steps_;
     std::vector<std::uint32_t> arrivals;
-    for (const std::uint32_t i : edm_->takeTcHandovers()) {
+    for (const std::uint32_t i : book_.takeTcHandovers()) {
         if (frozenModes_ || !edm_->owns(i)) continue;
         arrivals.push_back(i);
         ++counters_.tcHandovers;
         denseUntil_[zones_.zoneOf(edm_->positionAt(i, w_.time))] = steps_ + hs_.diluteSteps + hs_.relabelEvery;
     }
-    for (const std::uint32_t i : edm_->takeGuardEntries())
-        if (!frozenModes_ && edm_->owns(i) && guard_[edm_->cellOfParticle(i)] != 0) watch_.push_back(i);
+    for (const std::uint32_t i : book_.takeGuardEntries())
+        if (!frozenModes_ && edm_->owns(i) && guard_[book_.cellOf(i)] != 0) watch_.push_back(i);
     if (frozenModes_) return;
     // Mode changes wait for every relabelEvery-th step (each costs a pair-list rebuild), unless a particle would
     // touch a TDM particle before then. TDM particles move less than skin/2 between pair-list builds: relabelling
@@ -166,7 +149,7 @@ void HaetEngine<D>::synchronise() {
 
 template <int D>
 void HaetEngine<D>::bin(const Vec<D>& x, double r) {
-    const std::uint32_t c = edm_->cellIndex(x);
+    const std::uint32_t c = book_.cells().cellOf(x);
     if (binHead_[c] == kNil) binCells_.push_back(c);
     const auto b = static_cast<std::uint32_t>(bins_.size());
     bins_.push_back(Binned{x, r, binHead_[c], kNil});
@@ -180,14 +163,14 @@ void HaetEngine<D>::bin(const Vec<D>& x, double r) {
 
 template <int D>
 void HaetEngine<D>::markAround(std::uint32_t cell, std::uint8_t level) {
-    edm_->forEachNeighbourCell(cell, [&](std::uint32_t idx) {
+    book_.cells().forEachAround(cell, [&](std::uint32_t idx, const auto&) {
         std::uint8_t& g = guard_[idx];
         const std::uint8_t oldLevel = g & 3, newLevel = g >> 2;
         if (newLevel >= level) return;
         if (newLevel == 0) newList_.push_back(idx);
         g = static_cast<std::uint8_t>(oldLevel | (level << 2));
         if (level > oldLevel)  // occupants of a cell that became stricter are watched
-            edm_->forEachInCell(idx, [&](std::uint32_t i) { watch_.push_back(i); });
+            book_.forEachIn(idx, [&](std::uint32_t i) { watch_.push_back(i); });
     });
 }
 
@@ -275,7 +258,7 @@ void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals, bool due)
     std::size_t keep = 0;
     for (const std::uint32_t i : watch_) {
         if (!edm_->owns(i)) continue;
-        const std::uint8_t level = guard_[edm_->cellOfParticle(i)] & 3;
+        const std::uint8_t level = guard_[book_.cellOf(i)] & 3;
         if (level == 0) continue;
         // Near a TDM particle only: skipped while it provably stays beyond the margin (below).
         const Quiet& q = quiet_[i];
@@ -325,7 +308,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
     std::vector<int> zoneOf;
     if (due) {
         ++counters_.relabels;
-        std::vector<double> vol = edm_->zoneVolume();
+        std::vector<double> vol = book_.zoneVolume();
         zoneOf.resize(nT);
         for (std::size_t i = 0; i < nT; ++i) {
             zoneOf[i] = zones_.zoneOf(p.x[i]);
@@ -383,13 +366,13 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
         std::array<std::uint32_t, D> lo, hi, at;
         bool empty = false;
         for (int k = 0; k < D; ++k) {
-            lo[k] = zoneCellBegin_[k][zc[k]];
-            hi[k] = zoneCellBegin_[k][zc[k] + 1];
+            lo[k] = book_.zoneCellBegin()[k][zc[k]];
+            hi[k] = book_.zoneCellBegin()[k][zc[k] + 1];
             empty = empty || lo[k] >= hi[k];
             at[k] = lo[k];
         }
         if (empty) continue;
-        const std::array<int, D>& nc = edm_->cellDims();
+        const std::array<int, D>& nc = book_.cells().dims;
         for (;;) {
             std::uint32_t idx = 0, stride = 1;
             for (int k = 0; k < D; ++k) {
@@ -399,7 +382,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
             std::uint8_t& g = guard_[idx];
             if ((g >> 2) < 2) {
                 if ((g >> 2) == 0) newList_.push_back(idx);
-                if ((g & 3) < 2) edm_->forEachInCell(idx, [&](std::uint32_t i) { watch_.push_back(i); });
+                if ((g & 3) < 2) book_.forEachIn(idx, [&](std::uint32_t i) { watch_.push_back(i); });
                 g = static_cast<std::uint8_t>((g & 3) | (2 << 2));
             }
             int k = 0;
@@ -416,7 +399,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
     // candidates of the cells around it back on the work list.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> byCell;  // (cell, candidate), sorted
     byCell.reserve(candidates.size());
-    for (const std::uint32_t i : candidates) byCell.emplace_back(edm_->cellIndex(p.x[i]), i);
+    for (const std::uint32_t i : candidates) byCell.emplace_back(book_.cells().cellOf(p.x[i]), i);
     std::sort(byCell.begin(), byCell.end());
     std::vector<std::uint8_t> stays(byCell.size(), 0);
     std::vector<std::size_t> work(byCell.size());
@@ -431,7 +414,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
         const bool fresh = binHead_[c] == kNil;
         bin(p.x[i], p.radius[i]);
         if (fresh) markAround(c, 1);
-        edm_->forEachNeighbourCell(c, [&](std::uint32_t idx) {
+        book_.cells().forEachAround(c, [&](std::uint32_t idx, const auto&) {
             auto at = std::lower_bound(byCell.begin(), byCell.end(), std::make_pair(idx, std::uint32_t{0}));
             for (; at != byCell.end() && at->first == idx; ++at) {
                 const std::size_t r = static_cast<std::size_t>(at - byCell.begin());
@@ -472,6 +455,7 @@ void HaetEngine<D>::convert(std::vector<std::uint32_t> arrivals, std::vector<std
         if (a == b) return;
         p.swapEntries(a, b);
         edm_->swapIndices(a, b);
+        book_.swapped(a, b);
         std::swap(quiet_[a], quiet_[b]);
         auto oa = origin.find(a), ob = origin.find(b);
         const std::uint32_t ia = oa != origin.end() ? oa->second : a, ib = ob != origin.end() ? ob->second : b;
@@ -520,11 +504,11 @@ void HaetEngine<D>::convert(std::vector<std::uint32_t> arrivals, std::vector<std
     for (std::size_t k = 0; k < nT; ++k) {
         if (from[k] != TdmEngine<D>::kFresh) continue;
         bin(p.x[k], p.radius[k]);
-        edm_->forEachNeighbourCell(edm_->cellIndex(p.x[k]), [&](std::uint32_t idx) {
+        book_.cells().forEachAround(book_.cells().cellOf(p.x[k]), [&](std::uint32_t idx, const auto&) {
             if (guard_[idx] != 0) return;
             guard_[idx] = 1;
             guardList_.push_back(idx);
-            edm_->forEachInCell(idx, [&](std::uint32_t i) { watch_.push_back(i); });
+            book_.forEachIn(idx, [&](std::uint32_t i) { watch_.push_back(i); });
         });
     }
 }
@@ -540,7 +524,7 @@ std::size_t HaetEngine<D>::unwatchedInGuard() const {
     std::sort(watched.begin(), watched.end());
     std::size_t missing = 0;
     for (std::size_t i = nTdm(); i < w_.particles.size(); ++i)
-        if (guard_[edm_->cellOfParticle(i)] != 0 &&
+        if (guard_[book_.cellOf(static_cast<std::uint32_t>(i))] != 0 &&
             !std::binary_search(watched.begin(), watched.end(), static_cast<std::uint32_t>(i)))
             ++missing;
     return missing;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "edm/engine.hpp"
+#include "haet/edm_book.hpp"
 #include "haet/zones.hpp"
 #include "neighbor/cell_grid.hpp"
 #include "tdm/engine.hpp"
@@ -128,11 +129,12 @@ private:
     TdmSettings ts_;
     HaetSettings hs_;
     ZoneGrid<D> zones_;
+    // guard over the event grid: 0 free, 1 near a TDM particle (watched), 2 inside a time-driven zone
+    std::vector<std::uint8_t> guard_;
+    EdmBook<D> book_;  // where the event-driven particles are (the event-driven engine's observer)
     std::unique_ptr<EdmEngine<D>> edm_;
     std::unique_ptr<TdmEngine<D>> tdm_;
 
-    // guard over the event grid: 0 free, 1 near a TDM particle (watched), 2 inside a time-driven zone
-    std::vector<std::uint8_t> guard_;
     std::vector<std::uint32_t> guardList_, newList_;
     std::vector<std::uint32_t> binHead_, binCells_;
     std::vector<Binned> bins_;
@@ -149,9 +151,8 @@ private:
     };
     std::vector<Quiet> quiet_;
     std::uint64_t binsEpoch_ = 1;
-    std::array<std::vector<std::uint32_t>, D> zoneCellBegin_;  // per axis and zone coordinate: first cell coordinate
-    std::vector<std::uint64_t> lastTdmStep_;                   // per zone: last step it was time-driven
-    std::vector<std::uint64_t> denseUntil_;  // per zone: kept dense until this step (modified EDM hand-over)
+    std::vector<std::uint64_t> lastTdmStep_;  // per zone: last step it was time-driven
+    std::vector<std::uint64_t> denseUntil_;   // per zone: kept dense until this step (modified EDM hand-over)
     std::vector<std::uint8_t> sticky_, contact_;
     double margin_ = 0;   // distance at which an event-driven particle counts as near a TDM one [m]
     double vTdmMax_ = 0;  // fastest TDM particle at the last relabel [m/s]
