@@ -34,11 +34,9 @@ struct PolygonEntry {
 
 /// Work arrays of the polygon kernels, kept between steps so that no step allocates.
 struct PolygonScratch {
-    std::vector<V2> rotated;         ///< vertices of every shape turned by its particle's angle (body -> world
-                                     ///< without the translation) [m]
-    std::vector<double> inradius;    ///< per shape: distance from the centroid to the nearest edge line [m]
-    std::vector<double> pairEnergy;  ///< elastic energy of each listed pair of the last pass [J] (with a polygon)
-    std::vector<double> wallEnergy;  ///< of each (particle, wall) contact of a polygon [J]: [i * walls + w]
+    std::vector<V2> rotated;       ///< vertices of every shape turned by its particle's angle (body -> world
+                                   ///< without the translation) [m]
+    std::vector<double> inradius;  ///< per shape: distance from the centroid to the nearest edge line [m]
     PairPassScratch<2, PolygonEntry> pass;
 };
 
@@ -95,22 +93,17 @@ inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
     return o;
 }
 
-/// Evaluates pair slot k of particle i (at least one of the two a polygon): whether it touches, and its entry and
-/// elastic energy when it does. Frame: origin at x_j.
+/// Evaluates pair slot k of particle i (at least one of the two a polygon) with the pair's spring hist: whether it
+/// touches, and its entry (kEnergy: its elastic energy instead, hist a copy) when it does. Frame: origin at x_j.
 /// Inlined into the pass: a call per pair cost as much as the rejection of a pair that does not touch.
-template <class Law, bool kFriction>
-[[gnu::always_inline]] inline bool evalPolygonPair(const ForceContext<2>& ctx, const PolygonScratch& ps, std::size_t i,
-                                                   std::uint32_t k, PolygonEntry& out, double& energy) {
-    const Particles<2>& p = ctx.p;
-    const PairList<2>& pl = ctx.pl;
-    const ContactSetup& cs = ctx.cs;
-    const V2* sv = ctx.sv;
-    const Ang<2>* sw = ctx.sw;
-    const double dt = ctx.dt;
+template <class Law, bool kFriction, bool kEnergy = false>
+[[gnu::always_inline]] inline bool evalPolygonPair(const Particles<2>& p, const PairList<2>& pl, const ContactSetup& cs,
+                                                   const PolygonScratch& ps, const V2* sv, const Ang<2>* sw, double dt,
+                                                   std::size_t i, std::uint32_t k, V2& hist, PolygonEntry& out,
+                                                   double& energy) {
     const std::uint32_t j = pl.partner[k];
     const V2 d = p.x[i] - p.x[j] + pl.shiftVec[pl.shift[k]];
     const double ri = p.radius[i], rj = p.radius[j];
-    V2& hist = ctx.pl.history[k];
     const double dist2 = norm2(d);
     if (dist2 >= (ri + rj) * (ri + rj)) {
         if (!(hist == V2::zero())) hist = V2::zero();
@@ -147,10 +140,13 @@ template <class Law, bool kFriction>
     const double rmin = std::min(ri, rj);
     const PairLengths len = pairLengths(ri, rj);
     const ContactForce cf = polygonContact<Law, kFriction>(c, o, bi, bj, nullptr, len, cs.attraction, dt, hist);
+    if constexpr (kEnergy) {
+        energy = polygonContactEnergy<Law>(c, o, cf, len);  // geometry only: the velocities do not enter
+        return true;
+    }
     out.f = cf.f;
     out.ti = cf.torqueI;
     out.tj = cf.torqueJ;
-    energy = polygonContactEnergy<Law>(c, o, cf, len);
     out.vir = dot(d, cf.f);
     // Depth of the overlap, area / chord, relative to the smaller bounding radius (1 when the chord vanishes).
     const double clen = norm(o.chord);
@@ -163,64 +159,88 @@ template <class Law, bool kFriction>
 template <class Normal, class Tangential, class Law>
 class ShapeWall {
 public:
-    ShapeWall(const ForceContext<2>& ctx, PolygonScratch& ps) : ctx_(ctx), ps_(ps), disk_(ctx) {}
+    ShapeWall(const ForceContext<2>& ctx, const PolygonScratch& ps)
+        : ctx_(ctx),
+          ps_(ps),
+          disk_(ctx),
+          walls_(ctx.walls),
+          nw_(ctx.nWalls),
+          history_(ctx.wallHistory),
+          x_(ctx.p.x.data()),
+          radius_(ctx.p.radius.data()),
+          shape_(ctx.p.shape.data()),
+          time_(ctx.time) {}
 
     [[gnu::always_inline]] bool add(std::size_t i, std::size_t w, V2& f, Ang<2>& tq, double& worst) const {
-        const Particles<2>& p = ctx_.p;
-        const std::uint32_t si = p.shape[i];
-        if (si == kNoShape) return disk_.add(i, w, f, tq, worst);
-        const std::size_t iw = i * ctx_.nWalls + w;
-        const Wall<2>& wall = ctx_.walls[w];
-        V2& hist = ctx_.wallHistory[iw];
-        double& energy = ps_.wallEnergy[iw];
-        const double ri = p.radius[i];
-        const double dist = wall.distance(p.x[i], ctx_.time);
-        const V2& nrm = wall.normal;
+        if (shape_[i] == kNoShape) return disk_.add(i, w, f, tq, worst);
+        double energy;
+        return contact<false>(i, w, history_[i * nw_ + w], f, tq, worst, energy);
+    }
+
+    /// The energy of wall w's contact with particle i at the current state [J]: a disk's by its law, a polygon's
+    /// from its overlap (the spring copied, not changed).
+    double energy(std::size_t i, std::size_t w) const {
+        if (shape_[i] == kNoShape) return disk_.energy(i, w);
+        if (ctx_.p.flags[i] & kFrozen) return 0.0;  // never in contact
+        V2 hist = history_[i * nw_ + w], f = V2::zero();
+        Ang<2> tq = Ang<2>::zero();
+        double worst = 0, energy = 0;
+        return contact<true>(i, w, hist, f, tq, worst, energy) ? energy : 0.0;
+    }
+
+private:
+    template <bool kEnergy>
+    [[gnu::always_inline]] bool contact(std::size_t i, std::size_t w, V2& hist, V2& f, Ang<2>& tq, double& worst,
+                                        double& energy) const {
+        const Wall<2>& wall = walls_[w];
+        const double ri = radius_[i];
+        const double dist = wall.distance(x_[i], time_);
         Overlap o;
         if (!(dist >= ri)) {
             // Frame: origin at x_i.
-            const ShapeTable& st = p.shapes;
-            o = halfPlaneOverlap(ps_.rotated.data() + st.first[si], st.count(si), nrm * (-dist), nrm);
+            const ShapeTable& st = ctx_.p.shapes;
+            const std::uint32_t si = shape_[i];
+            o = halfPlaneOverlap(ps_.rotated.data() + st.first[si], st.count(si), wall.normal * (-dist), wall.normal);
         }
         if (!(o.area > 0)) {
             if (!(hist == V2::zero())) hist = V2::zero();
-            energy = 0;
             return false;
         }
-        const BodyState bi = bodyOf(p, ctx_.sv, ctx_.sw, i);
+        const BodyState bi = bodyOf(ctx_.p, ctx_.sv, ctx_.sw, i);
         BodyState bw;
         bw.v = wall.velocity;
         bw.vStep = wall.velocity;
-        const PolygonCoeffs& pc = ctx_.cs.polygonPair(p.material[i], wall.material);
+        const PolygonCoeffs& pc = ctx_.cs.polygonPair(ctx_.p.material[i], wall.material);
         const PairLengths len = wallLengths(ri);
-        const ContactForce cf =
-            polygonContact<Law, Tangential::kHasHistory>(pc, o, bi, bw, &nrm, len, ctx_.cs.attraction, ctx_.dt, hist);
+        const ContactForce cf = polygonContact<Law, Tangential::kHasHistory>(pc, o, bi, bw, &wall.normal, len,
+                                                                             ctx_.cs.attraction, ctx_.dt, hist);
+        if constexpr (kEnergy) {
+            energy = polygonContactEnergy<Law>(pc, o, cf, len);
+            return true;
+        }
         f += cf.f;
         tq[0] += cf.torqueI;
-        energy = polygonContactEnergy<Law>(pc, o, cf, len);
         const double clen = norm(o.chord);
         worst = std::max(worst, clen > 0 ? o.area / clen / ri : 1.0);
         return true;
     }
 
-    /// The energy of wall w's contact with particle i: a disk's by its law, a polygon's as its last pass found it.
-    double energy(std::size_t i, std::size_t w) const {
-        const Particles<2>& p = ctx_.p;
-        if (p.shape[i] == kNoShape) return disk_.energy(i, w);
-        const std::size_t iw = i * ctx_.nWalls + w;
-        if ((p.flags[i] & kFrozen) || iw >= ps_.wallEnergy.size()) return 0.0;  // frozen: never in contact
-        return ps_.wallEnergy[iw];
-    }
-
-private:
     const ForceContext<2>& ctx_;
-    PolygonScratch& ps_;
+    const PolygonScratch& ps_;
     DiskWall<2, Normal, Tangential> disk_;
+    const Wall<2>* walls_;
+    std::size_t nw_;
+    V2* history_;
+    const V2* x_;
+    const double* radius_;
+    const std::uint32_t* shape_;
+    double time_;
 };
 
 /// The kernel of the pair pass for scenes with polygons (tdm/pair_pass.hpp has the interface). Normal, Tangential:
 /// the disk laws (pairs of two disks, and the friction of polygon contacts: TangentialLaw::Spring); Law: the
-/// polygon law (OverlapAreaLaw, PotentialLaw). Pair energies are kept as the pass finds them (pairEnergy).
+/// polygon law (OverlapAreaLaw, PotentialLaw). Energies are those of the
+/// contacts' overlaps at the current state (energy()).
 template <class Normal, class Tangential, class Law>
 class PolygonKernel {
 public:
@@ -235,11 +255,17 @@ public:
         double ti, tj;
     };
 
-    PolygonKernel(const ForceContext<2>& ctx, PolygonScratch& ps)
+    PolygonKernel(const ForceContext<2>& ctx, const PolygonScratch& ps)
         : ctx_(ctx),
           ps_(ps),
           in_(pairInputs(ctx.p, ctx.pl, ctx.cs, ctx.sv, ctx.sw, ctx.dt)),
           shape_(ctx.p.shape.data()),
+          p_(ctx.p),
+          pl_(ctx.pl),
+          cs_(ctx.cs),
+          sv_(ctx.sv),
+          sw_(ctx.sw),
+          dt_(ctx.dt),
           walls_(ctx, ps) {}
 
     [[gnu::always_inline]] static Load load(const Entry& x) { return {x.f, x.ti, x.tj}; }
@@ -256,41 +282,50 @@ public:
     [[gnu::always_inline]] Ang<2> torqueOf(std::size_t, const Sum& s) const { return s.t; }
     const ShapeWall<Normal, Tangential, Law>& walls() const { return walls_; }
 
-    /// One listed pair, whichever its kind; records its elastic energy (0 when not touching).
+    /// One listed pair, whichever its kind.
     [[gnu::always_inline]] bool pair(std::size_t i, std::uint32_t k, Entry& e) const {
         const std::uint32_t j = in_.partner[k];
-        double energy = 0;
-        bool touching;
         if (shape_[i] == kNoShape && shape_[j] == kNoShape) {
             PairForce<2> pf;
             double overlap = 0, vir = 0;
-            touching = evalPair<2, Normal, Tangential>(in_, Owner<2>(in_, i), k, pf, overlap, vir);
-            if (touching) {
-                e.f = pf.f;
-                e.ti = -in_.radius[i] * pf.nxft[0];
-                e.tj = -in_.radius[j] * pf.nxft[0];
-                e.vir = vir;
-                e.ovl = overlap;
-            }
-            // Two disks: their energy comes from their law when asked (energy()).
-        } else {
-            touching = evalPolygonPair<Law, Tangential::kHasHistory>(ctx_, ps_, i, k, e, energy);
+            if (!evalPair<2, Normal, Tangential>(in_, Owner<2>(in_, i), k, pf, overlap, vir)) return false;
+            e.f = pf.f;
+            e.ti = -in_.radius[i] * pf.nxft[0];
+            e.tj = -in_.radius[j] * pf.nxft[0];
+            e.vir = vir;
+            e.ovl = overlap;
+            return true;
         }
-        ps_.pairEnergy[k] = touching ? energy : 0.0;
-        return touching;
+        double energy;
+        return evalPolygonPair<Law, Tangential::kHasHistory>(p_, pl_, cs_, ps_, sv_, sw_, dt_, i, k, in_.history[k], e,
+                                                             energy);
     }
 
+    /// The energy of listed pair k at the current state [J]: two disks' by their law, a polygon contact's from its
+    /// overlap (the spring copied, not changed).
     double energy(std::size_t i, std::uint32_t k) const {
-        const Particles<2>& p = ctx_.p;
-        if (p.shape[i] == kNoShape && p.shape[in_.partner[k]] == kNoShape) return diskPairEnergy<2, Normal>(ctx_, i, k);
-        return k < ps_.pairEnergy.size() ? ps_.pairEnergy[k] : 0.0;  // a list changed since (remap): no record
+        if (shape_[i] == kNoShape && shape_[in_.partner[k]] == kNoShape) return diskPairEnergy<2, Normal>(ctx_, i, k);
+        V2 hist = in_.history[k];
+        Entry e;
+        double energy = 0;
+        return evalPolygonPair<Law, Tangential::kHasHistory, true>(p_, pl_, cs_, ps_, sv_, sw_, dt_, i, k, hist, e,
+                                                                   energy)
+                   ? energy
+                   : 0.0;
     }
 
 private:
     const ForceContext<2>& ctx_;
-    PolygonScratch& ps_;
+    const PolygonScratch& ps_;
     PairInputs<2> in_;
     const std::uint32_t* shape_;
+    // What a polygon pair reads, as references and values of their own (not reloaded through the context).
+    const Particles<2>& p_;
+    const PairList<2>& pl_;
+    const ContactSetup& cs_;
+    const V2* sv_;
+    const Ang<2>* sw_;
+    double dt_;
     ShapeWall<Normal, Tangential, Law> walls_;
 };
 

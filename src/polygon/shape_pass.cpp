@@ -15,8 +15,6 @@ class PolygonPass final : public ShapePass {
 public:
     ForceStats forces(const ForceContext<2>& ctx) override {
         polygon::rotateShapes(ctx.p, ps_);
-        ps_.pairEnergy.resize(ctx.pl.size());  // written for every listed pair
-        ps_.wallEnergy.resize(ctx.p.tdmCount() * ctx.nWalls);
         const polygon::PolygonKernel<Normal, Tangential, Law> kernel(ctx, ps_);
         auto none = [](std::size_t, const Vec<2>&, const Ang<2>&) {};
         return runPairPass(ctx, kernel, ps_.pass, none);

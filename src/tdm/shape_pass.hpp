@@ -17,7 +17,7 @@ public:
     virtual ~ShapePass() = default;
     /// Forces and torques of every particle at the predicted state, as computeForces for disks.
     virtual ForceStats forces(const ForceContext<2>& ctx) = 0;
-    /// The elastic energy of the contacts at the state of the last forces() [J], as the kernels' laws give it.
+    /// The elastic energy of the contacts at the current state [J], as the kernels' laws give it.
     virtual double energy(const ForceContext<2>& ctx) = 0;
 };
 
