@@ -93,15 +93,27 @@ inline void rotateShapes(const Particles<2>& p, PolygonScratch& ps) {
     return o;
 }
 
-/// Evaluates pair slot k of particle i (at least one of the two a polygon) with the pair's spring hist: whether it
-/// touches, and its entry (kEnergy: its elastic energy instead, hist a copy) when it does. Frame: origin at x_j.
-/// Inlined into the pass: a call per pair cost as much as the rejection of a pair that does not touch.
+/// What a polygon pair reads, taken once per pass.
+struct PolygonViews {
+    const Particles<2>& p;
+    const PairList<2>& pl;
+    const ContactSetup& cs;
+    const PolygonScratch& ps;
+    const V2* sv;
+    const Ang<2>* sw;
+    double dt;
+};
+
+/// Evaluates pair slot k of particle i and partner j (at least one of the two a polygon) with the pair's spring
+/// hist: whether it touches, and its entry (kEnergy: its elastic energy instead, hist a copy) when it does. Frame:
+/// origin at x_j. Inlined into the pass: a call per pair cost as much as the rejection of a pair that does not touch.
 template <class Law, bool kFriction, bool kEnergy = false>
-[[gnu::always_inline]] inline bool evalPolygonPair(const Particles<2>& p, const PairList<2>& pl, const ContactSetup& cs,
-                                                   const PolygonScratch& ps, const V2* sv, const Ang<2>* sw, double dt,
-                                                   std::size_t i, std::uint32_t k, V2& hist, PolygonEntry& out,
-                                                   double& energy) {
-    const std::uint32_t j = pl.partner[k];
+[[gnu::always_inline]] inline bool evalPolygonPair(const PolygonViews& in, std::size_t i, std::uint32_t k,
+                                                   std::uint32_t j, V2& hist, PolygonEntry& out, double& energy) {
+    const Particles<2>& p = in.p;
+    const PairList<2>& pl = in.pl;
+    const ContactSetup& cs = in.cs;
+    const PolygonScratch& ps = in.ps;
     const V2 d = p.x[i] - p.x[j] + pl.shiftVec[pl.shift[k]];
     const double ri = p.radius[i], rj = p.radius[j];
     const double dist2 = norm2(d);
@@ -133,13 +145,13 @@ template <class Law, bool kFriction, bool kEnergy = false>
         if (!(hist == V2::zero())) hist = V2::zero();
         return false;
     }
-    BodyState bi = bodyOf(p, sv, sw, i);
+    BodyState bi = bodyOf(p, in.sv, in.sw, i);
     bi.x = d;
-    const BodyState bj = bodyOf(p, sv, sw, j);
+    const BodyState bj = bodyOf(p, in.sv, in.sw, j);
     const PolygonCoeffs& c = cs.polygonPair(p.material[i], p.material[j]);
     const double rmin = std::min(ri, rj);
     const PairLengths len = pairLengths(ri, rj);
-    const ContactForce cf = polygonContact<Law, kFriction>(c, o, bi, bj, nullptr, len, cs.attraction, dt, hist);
+    const ContactForce cf = polygonContact<Law, kFriction>(c, o, bi, bj, nullptr, len, cs.attraction, in.dt, hist);
     if constexpr (kEnergy) {
         energy = polygonContactEnergy<Law>(c, o, cf, len);  // geometry only: the velocities do not enter
         return true;
@@ -173,8 +185,15 @@ public:
 
     [[gnu::always_inline]] bool add(std::size_t i, std::size_t w, V2& f, Ang<2>& tq, double& worst) const {
         if (shape_[i] == kNoShape) return disk_.add(i, w, f, tq, worst);
+        // Most walls are beyond the bounding circle: that test first, the overlap out of line.
+        const double dist = walls_[w].distance(x_[i], time_);
+        V2& hist = history_[i * nw_ + w];
+        if (dist >= radius_[i]) {
+            if (!(hist == V2::zero())) hist = V2::zero();
+            return false;
+        }
         double energy;
-        return contact<false>(i, w, history_[i * nw_ + w], f, tq, worst, energy);
+        return contact<false>(i, w, dist, hist, f, tq, worst, energy);
     }
 
     /// The energy of wall w's contact with particle i at the current state [J]: a disk's by its law, a polygon's
@@ -185,23 +204,23 @@ public:
         V2 hist = history_[i * nw_ + w], f = V2::zero();
         Ang<2> tq = Ang<2>::zero();
         double worst = 0, energy = 0;
-        return contact<true>(i, w, hist, f, tq, worst, energy) ? energy : 0.0;
+        const double dist = walls_[w].distance(x_[i], time_);
+        if (dist >= radius_[i]) return 0.0;
+        return contact<true>(i, w, dist, hist, f, tq, worst, energy) ? energy : 0.0;
     }
 
 private:
+    /// The contact of a polygon i within its bounding radius of wall w (at distance dist).
     template <bool kEnergy>
-    [[gnu::always_inline]] bool contact(std::size_t i, std::size_t w, V2& hist, V2& f, Ang<2>& tq, double& worst,
-                                        double& energy) const {
+    [[gnu::noinline]] bool contact(std::size_t i, std::size_t w, double dist, V2& hist, V2& f, Ang<2>& tq,
+                                   double& worst, double& energy) const {
         const Wall<2>& wall = walls_[w];
         const double ri = radius_[i];
-        const double dist = wall.distance(x_[i], time_);
-        Overlap o;
-        if (!(dist >= ri)) {
-            // Frame: origin at x_i.
-            const ShapeTable& st = ctx_.p.shapes;
-            const std::uint32_t si = shape_[i];
-            o = halfPlaneOverlap(ps_.rotated.data() + st.first[si], st.count(si), wall.normal * (-dist), wall.normal);
-        }
+        // Frame: origin at x_i.
+        const ShapeTable& st = ctx_.p.shapes;
+        const std::uint32_t si = shape_[i];
+        const Overlap o =
+            halfPlaneOverlap(ps_.rotated.data() + st.first[si], st.count(si), wall.normal * (-dist), wall.normal);
         if (!(o.area > 0)) {
             if (!(hist == V2::zero())) hist = V2::zero();
             return false;
@@ -260,12 +279,7 @@ public:
           ps_(ps),
           in_(pairInputs(ctx.p, ctx.pl, ctx.cs, ctx.sv, ctx.sw, ctx.dt)),
           shape_(ctx.p.shape.data()),
-          p_(ctx.p),
-          pl_(ctx.pl),
-          cs_(ctx.cs),
-          sv_(ctx.sv),
-          sw_(ctx.sw),
-          dt_(ctx.dt),
+          views_{ctx.p, ctx.pl, ctx.cs, ps, ctx.sv, ctx.sw, ctx.dt},
           walls_(ctx, ps) {}
 
     [[gnu::always_inline]] static Load load(const Entry& x) { return {x.f, x.ti, x.tj}; }
@@ -282,9 +296,8 @@ public:
     [[gnu::always_inline]] Ang<2> torqueOf(std::size_t, const Sum& s) const { return s.t; }
     const ShapeWall<Normal, Tangential, Law>& walls() const { return walls_; }
 
-    /// One listed pair, whichever its kind.
-    [[gnu::always_inline]] bool pair(std::size_t i, std::uint32_t k, Entry& e) const {
-        const std::uint32_t j = in_.partner[k];
+    /// One listed pair (partner j), whichever its kind.
+    [[gnu::always_inline]] bool pair(std::size_t i, std::uint32_t k, std::uint32_t j, Entry& e) const {
         if (shape_[i] == kNoShape && shape_[j] == kNoShape) {
             PairForce<2> pf;
             double overlap = 0, vir = 0;
@@ -297,8 +310,7 @@ public:
             return true;
         }
         double energy;
-        return evalPolygonPair<Law, Tangential::kHasHistory>(p_, pl_, cs_, ps_, sv_, sw_, dt_, i, k, in_.history[k], e,
-                                                             energy);
+        return evalPolygonPair<Law, Tangential::kHasHistory>(views_, i, k, j, in_.history[k], e, energy);
     }
 
     /// The energy of listed pair k at the current state [J]: two disks' by their law, a polygon contact's from its
@@ -308,8 +320,7 @@ public:
         V2 hist = in_.history[k];
         Entry e;
         double energy = 0;
-        return evalPolygonPair<Law, Tangential::kHasHistory, true>(p_, pl_, cs_, ps_, sv_, sw_, dt_, i, k, hist, e,
-                                                                   energy)
+        return evalPolygonPair<Law, Tangential::kHasHistory, true>(views_, i, k, in_.partner[k], hist, e, energy)
                    ? energy
                    : 0.0;
     }
@@ -319,13 +330,7 @@ private:
     const PolygonScratch& ps_;
     PairInputs<2> in_;
     const std::uint32_t* shape_;
-    // What a polygon pair reads, as references and values of their own (not reloaded through the context).
-    const Particles<2>& p_;
-    const PairList<2>& pl_;
-    const ContactSetup& cs_;
-    const V2* sv_;
-    const Ang<2>* sw_;
-    double dt_;
+    PolygonViews views_;  ///< what a polygon pair reads (not reloaded through the context)
     ShapeWall<Normal, Tangential, Law> walls_;
 };
 

@@ -513,8 +513,8 @@ public:
     [[gnu::always_inline]] KernelVec<A> torqueOf(std::size_t i, const Sum& s) const { return s.a * (-in_.radius[i]); }
     const DiskWall<D, Normal, Tangential>& walls() const { return walls_; }
 
-    /// One listed pair (a cross pair of the thread split).
-    bool pair(std::size_t i, std::uint32_t k, Entry& e) const {
+    /// One listed pair (a cross pair of the thread split; evalPair loads the partner itself).
+    bool pair(std::size_t i, std::uint32_t k, std::uint32_t /*j*/, Entry& e) const {
         PairForce<D> pf;
         double overlap = 0, vir = 0;
         if (!evalPair<D, Normal, Tangential>(in_, Owner<D>(in_, i), k, pf, overlap, vir)) return false;

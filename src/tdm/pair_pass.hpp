@@ -26,7 +26,7 @@
 //   K::Sum             a particle's running sums: K::sumOf(f, a) from the stored ones, K::addOwner(sum, load),
 //                      K::addPartner(f, a, load) into the stored ones of the partner, K::forceOf(sum)
 //   k.torqueOf(i, sum) the torque of the pair sums
-//   k.pair(i, k, e)    one listed pair (slot k of owner i): whether it touches, its entry (the cross pairs)
+//   k.pair(i, k, j, e) one listed pair (slot k of owner i, partner j): whether it touches, its entry
 //   K::kOneByOne       true: the pass evaluates the pairs one by one as their owner comes (k.pair) and adds each
 //                      at once; false: block by block, the kernel filling a block's entries first:
 //   k.block<kCross>(b0, b1, e, cross, c, bl)  the entries of the block's pairs (see PairBlock), the cross pairs
@@ -264,7 +264,7 @@ template <int D, class K, bool kCross, class Then>
                 }
             }
             Entry x;
-            if (!kernel.pair(i, k, x)) continue;
+            if (!kernel.pair(i, k, j, x)) continue;
             const typename K::Load l = K::load(x);
             K::addOwner(s, l);
             K::addPartner(f[j], nx[j], l);
@@ -400,7 +400,7 @@ ForceStats runPairPass(const ForceContext<D>& ctx, const K& kernel, PairPassScra
         // The cross pairs first: every particle is still unfinished.
 #pragma omp for schedule(static)
         for (std::size_t c = 0; c < ncross; ++c)
-            cross[c].touching = kernel.pair(sp.crossOwner[c], sp.crossSlot[c], cross[c].e);
+            cross[c].touching = kernel.pair(sp.crossOwner[c], sp.crossSlot[c], pl.partner[sp.crossSlot[c]], cross[c].e);
 #pragma omp for schedule(static, 1)
         for (int r = 0; r < nt; ++r) {
             const std::uint64_t* ci = sp.crossIn.data();
