@@ -117,7 +117,16 @@ struct LinearNormal {
         const S kn = c.knConst + c.knPerMeff * meff;
         return {kn * delta + c.gnPerMeff * meff * deltaDot, kn};
     }
+    /// Elastic energy of the spring, k_n delta^2 / 2 [J].
+    static double energy(const PairCoeffs& c, double delta, double meff, double /*reff*/) {
+        return 0.5 * (c.knConst + c.knPerMeff * meff) * delta * delta;
+    }
 };
+
+/// Elastic energy of a Hertz contact, (2/5) k_H sqrt(R) delta^{5/2} [J]: the work of rho delta^{3/2} (B.3).
+inline double hertzEnergy(const PairCoeffs& c, double delta, double reff) {
+    return 0.4 * c.hertzK * std::sqrt(reff) * std::pow(delta, 2.5);
+}
 
 /// Hertz with viscoelastic damping (Brilliantov et al. 1996; B.3): F = rho delta^{3/2} + A* rho sqrt(delta) delta_dot.
 struct HertzViscoNormal {
@@ -126,6 +135,7 @@ struct HertzViscoNormal {
         const S k = c.hertzK * sqrtOf(reff * delta);  // secant stiffness rho sqrt(delta)
         return {k * (delta + c.dissipationTime * deltaDot), k};
     }
+    static double energy(const PairCoeffs& c, double delta, double, double reff) { return hertzEnergy(c, delta, reff); }
 };
 
 /// Hertz with Tsuji damping: F = k_H delta^{3/2} + alpha sqrt(2 m_eff k_H) delta^{1/4} delta_dot, k_H = hertzK sqrt(R).
@@ -138,6 +148,7 @@ struct HertzTsujiNormal {
         const S damp = c.tsujiAlpha * sqrtOf(2.0 * meff * kH) * sqrtOf(sd);
         return {kH * delta * sd + damp * deltaDot, kH * sd};
     }
+    static double energy(const PairCoeffs& c, double delta, double, double reff) { return hertzEnergy(c, delta, reff); }
 };
 
 /// Tsuji's polynomial alpha(e) for the damping coefficient (LAMMPS pair_granular docs).

@@ -1,6 +1,6 @@
 #pragma once
 // Four doubles side by side, one per contact, for the force loop's contact law on four touching pairs at once
-// (tdm/forces.hpp). Lane by lane the arithmetic is that of double in the same order, with the same correctly
+// (tdm/disk_kernel.hpp). Lane by lane the arithmetic is that of double in the same order, with the same correctly
 // rounded operations (+ - * / and the square root; no fused multiply-add under -ffp-contract=off), so a contact
 // evaluated in a lane gives the bits it gives alone. A branch of the scalar law becomes select(): both sides are
 // computed and each lane keeps its own, which is the value its branch would have given.

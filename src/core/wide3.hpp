@@ -1,6 +1,6 @@
 #pragma once
 // A 3-vector held in one 4-lane register, the fourth lane zero, for the contact kernel of the 3D force loop
-// (tdm/forces.hpp): with AVX an add, subtract or scale is one instruction instead of three (GCC does not
+// (tdm/disk_kernel.hpp): with AVX an add, subtract or scale is one instruction instead of three (GCC does not
 // vectorise the 3-element loops of Vec<3> itself). Lane by lane the arithmetic is that of Vec<3> in the same
 // order: dot products sum (x y) + (x y) + (z z) left to right; no fused multiply-add under -ffp-contract=off.
 // Storage stays Vec<3> (24 bytes): Wide3 lives in registers only.

@@ -78,6 +78,14 @@ inline double areaRate(const Overlap& o, const BodyState& bi, const BodyState& b
            bj.w * (o.spin + dot(o.centroid - bj.x, o.chord));
 }
 
+/// The polygon laws as types, so that a force pass is instantiated per law (as the disk laws, contact/laws.hpp).
+struct OverlapAreaLaw {
+    static constexpr bool kPotential = false;  ///< the overlap-area law (G.3)
+};
+struct PotentialLaw {
+    static constexpr bool kPotential = true;  ///< the energy-conserving variant, U = Y A^2 / (2 L^2)
+};
+
 /// Evaluates the law for an overlap `o` of body i (its outline gave o.chord and o.spin) with body j.
 /// `wallNormal` (unit, pointing to i) replaces the chord's normal and makes j a wall: then l = 4 |r_i|.
 /// xi: the tangential spring [m], stored as a vector along t so that it changes sign with the pair's order.
@@ -85,10 +93,11 @@ inline double areaRate(const Overlap& o, const BodyState& bi, const BodyState& b
 /// when the centres coincide; the potential law's force then vanishes with |c| (a depth that max_overlap stops).
 /// Always inlined: as a call (its frame, register saves and the copies of its arguments) it cost the polygon force
 /// pass 3 % more instructions.
+/// Law: OverlapAreaLaw or PotentialLaw (the normal force); kFriction: the tangential spring (TangentialLaw::Spring).
+template <class Law, bool kFriction>
 [[gnu::always_inline]] inline ContactForce polygonContact(const PolygonCoeffs& c, const Overlap& o, const BodyState& bi,
                                                           const BodyState& bj, const V2* wallNormal,
-                                                          const PairLengths& len, bool attraction, bool friction,
-                                                          double dt, V2& xi) {
+                                                          const PairLengths& len, bool attraction, double dt, V2& xi) {
     ContactForce out;
     const double clen = norm(o.chord);
     const bool hasChord = clen > 1e-12 * std::sqrt(o.area);
@@ -103,10 +112,10 @@ inline double areaRate(const Overlap& o, const BodyState& bi, const BodyState& b
         n = dl > 0 ? d / dl : V2{{1.0, 0.0}};
     }
     // Elastic force [N] and force point; l (overlap-area law) or |c| / L^2 (potential law) [1/m].
-    const bool potential = c.law == PolygonLaw::Potential;
+    constexpr bool potential = Law::kPotential;
     double fel, l = 0, cOverL2 = 0;
     V2 at = o.centroid;
-    if (potential) {
+    if constexpr (potential) {
         if (hasChord) at += o.chord * (o.spin / (clen * clen));
         cOverL2 = clen / len.potential;
         fel = c.young * o.area * cOverL2;
@@ -136,7 +145,7 @@ inline double areaRate(const Overlap& o, const BodyState& bi, const BodyState& b
     if (!attraction && fn < 0) fn = 0;
     V2 f = n * fn;
 
-    if (friction && c.kt > 0) {
+    if (kFriction && c.kt > 0) {
         const V2 t = perp(n);
         // The contact line turns with the pair: keep the spring's length, take its sign along the new tangent.
         const double xl = norm(xi);
@@ -166,11 +175,31 @@ inline double areaRate(const Overlap& o, const BodyState& bi, const BodyState& b
 /// Elastic energy of a contact [J]. The potential law's is exact, Y A^2 / (2 L^2). The overlap-area law has no
 /// potential (PHYSICS.md G.3); its energy is estimated as Y A^2 / (2 l |c|): exact for a flat contact
 /// (A = |c| depth), 3/4 of the work done for a vertex contact (A ~ depth^2).
+template <class Law>
 inline double polygonContactEnergy(const PolygonCoeffs& c, const Overlap& o, const ContactForce& f,
                                    const PairLengths& len) {
-    if (c.law == PolygonLaw::Potential) return c.young * o.area * o.area / (2 * len.potential);
-    const double clen = norm(o.chord);
-    return clen > 0 && f.length > 0 ? c.young * o.area * o.area / (2 * f.length * clen) : 0.0;
+    if constexpr (Law::kPotential) {
+        return c.young * o.area * o.area / (2 * len.potential);
+    } else {
+        const double clen = norm(o.chord);
+        return clen > 0 && f.length > 0 ? c.young * o.area * o.area / (2 * f.length * clen) : 0.0;
+    }
+}
+
+/// The law of c.law and friction chosen at run time (tests, set-up): polygonContact<Law, kFriction>.
+inline ContactForce polygonContact(const PolygonCoeffs& c, const Overlap& o, const BodyState& bi, const BodyState& bj,
+                                   const V2* wallNormal, const PairLengths& len, bool attraction, bool friction,
+                                   double dt, V2& xi) {
+    if (c.law == PolygonLaw::Potential)
+        return friction ? polygonContact<PotentialLaw, true>(c, o, bi, bj, wallNormal, len, attraction, dt, xi)
+                        : polygonContact<PotentialLaw, false>(c, o, bi, bj, wallNormal, len, attraction, dt, xi);
+    return friction ? polygonContact<OverlapAreaLaw, true>(c, o, bi, bj, wallNormal, len, attraction, dt, xi)
+                    : polygonContact<OverlapAreaLaw, false>(c, o, bi, bj, wallNormal, len, attraction, dt, xi);
+}
+inline double polygonContactEnergy(const PolygonCoeffs& c, const Overlap& o, const ContactForce& f,
+                                   const PairLengths& len) {
+    return c.law == PolygonLaw::Potential ? polygonContactEnergy<PotentialLaw>(c, o, f, len)
+                                          : polygonContactEnergy<OverlapAreaLaw>(c, o, f, len);
 }
 
 }  // namespace haet::polygon

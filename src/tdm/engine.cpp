@@ -4,8 +4,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "polygon/forces.hpp"
-
 namespace haet {
 
 template <int D>
@@ -13,7 +11,7 @@ TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s
     if (!w_.particles.hasTdmState())
         throw std::invalid_argument("time-driven engine: the particle store has dropped forces and torques");
     if constexpr (D == 2)
-        if (w_.particles.hasPolygons()) poly_ = std::make_unique<polygon::PolygonScratch>();
+        if (w_.particles.hasPolygons()) shapes_ = makeShapePass(w_.contact);
     if (s.integrator == IntegratorKind::Gear5) {
         integ_ = std::make_unique<Gear5<D>>();
     } else {
@@ -33,20 +31,26 @@ template <int D>
 TdmEngine<D>::~TdmEngine() = default;
 
 template <int D>
+ForceContext<D> TdmEngine<D>::context(const Vec<D>* sv, const Ang<D>* sw) const {
+    // A force pass writes the pair list's and the walls' springs; the energy pass (const) only reads them.
+    return forceContext(w_.particles, const_cast<PairList<D>&>(pairs_), w_.walls,
+                        const_cast<std::vector<Vec<D>>&>(wallHistory_), w_.contact, w_.domain, w_.time, s_.dt, sv, sw);
+}
+
+template <int D>
 void TdmEngine<D>::computeForces(bool correct, std::atomic<bool>* nextMoved) {
     const ContactSetup& cs = w_.contact;
+    if constexpr (D == 2) {
+        if (shapes_) {  // polygons present: their pass also serves the disks among them
+            stats_ = shapes_->forces(context(motion_.v.data(), motion_.w.data()));
+            if (correct) integ_->correct(w_.particles, s_.dt, motion_);
+            return;
+        }
+    }
     bool corrected = false;
     auto run = [&](auto normal, auto tangential) {
         using N = decltype(normal);
         using T = decltype(tangential);
-        if constexpr (D == 2) {
-            if (poly_) {  // polygons present: their loop (polygon/forces.hpp) also serves the disks among them
-                stats_ =
-                    polygon::computePolygonForces<N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain,
-                                                        w_.time, s_.dt, motion_.v.data(), motion_.w.data(), *poly_);
-                return;
-            }
-        }
         auto forces = [&](auto then) {
             stats_ = haet::computeForces<D, N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain, w_.time,
                                                   s_.dt, motion_.v.data(), motion_.w.data(), scratch_, then);
@@ -194,7 +198,7 @@ void TdmEngine<D>::advanceTo(double t) {
     // Every step but the last predicts the next one in its force pass when the corrector runs there (velocity
     // Verlet, no polygons): the same arithmetic per particle, so the state at the end is the one of step() after
     // step(), bit for bit, with one pass over the particles a step instead of two.
-    const bool fuse = verlet_ != nullptr && !poly_;
+    const bool fuse = verlet_ != nullptr && !shapes_;
     bool predicted = false, moved = false;
     while (w_.time + 0.5 * s_.dt <= t) {
         if (!predicted) moved = integ_->predict(w_.particles, s_.dt, motion_, xAtBuild_.data(), driftLimit2());
@@ -226,36 +230,11 @@ void TdmEngine<D>::checkHealth() const {
 
 template <int D>
 double TdmEngine<D>::contactEnergy() const {
-    const Particles<D>& p = w_.particles;
-    const ContactSetup& cs = w_.contact;
-    auto elastic = [&](const PairCoeffs& c, double delta, double meff, double reff) {
-        if (cs.normal == NormalLaw::Linear) return 0.5 * (c.knConst + c.knPerMeff * meff) * delta * delta;
-        return 0.4 * c.hertzK * std::sqrt(reff) * std::pow(delta, 2.5);
-    };
-    double e = 0;
-    if (poly_) {  // polygon contacts: the estimates of the last force evaluation (polygon/contact.hpp)
-        for (double x : poly_->pairEnergy) e += x;
-        for (double x : poly_->wallEnergy) e += x;
-    }
-    for (std::size_t i = 0; i < p.tdmCount(); ++i) {
-        for (std::uint32_t k = pairs_.first[i]; k < pairs_.first[i + 1]; ++k) {
-            const std::uint32_t j = pairs_.partner[k];
-            if (poly_ && (p.isPolygon(i) || p.isPolygon(j))) continue;
-            const Vec<D> d = p.x[i] - p.x[j] + pairs_.shiftVec[pairs_.shift[k]];
-            const double rs = p.radius[i] + p.radius[j];
-            const double delta = rs - norm(d);
-            if (delta <= 0) continue;
-            const bool fi = p.frozen(i), fj = p.frozen(j);
-            const double meff = fi ? p.mass[j] : (fj ? p.mass[i] : p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]));
-            e += elastic(cs.pair(p.material[i], p.material[j]), delta, meff, p.radius[i] * p.radius[j] / rs);
-        }
-        if (poly_ && p.isPolygon(i)) continue;
-        for (const Wall<D>& wall : w_.walls) {
-            const double delta = p.radius[i] - wall.distance(p.x[i], w_.time);
-            if (delta > 0) e += elastic(cs.pair(p.material[i], wall.material), delta, p.mass[i], p.radius[i]);
-        }
-    }
-    return e;
+    const ForceContext<D> ctx = context(motion_.v.data(), motion_.w.data());
+    if constexpr (D == 2)
+        if (shapes_) return shapes_->energy(ctx);
+    if (w_.contact.normal == NormalLaw::Linear) return diskContactEnergy<D, LinearNormal>(ctx);
+    return diskContactEnergy<D, HertzViscoNormal>(ctx);  // both Hertz laws store (2/5) k_H sqrt(R) delta^{5/2}
 }
 
 template <int D>

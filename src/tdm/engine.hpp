@@ -11,13 +11,10 @@
 #include "neighbor/pair_list.hpp"
 #include "tdm/forces.hpp"
 #include "tdm/integrators.hpp"
+#include "tdm/shape_pass.hpp"
 #include "world/world.hpp"
 
 namespace haet {
-
-namespace polygon {
-struct PolygonScratch;
-}
 
 struct TdmSettings {
     IntegratorKind integrator = IntegratorKind::Verlet;
@@ -72,6 +69,8 @@ private:
     double driftLimit2() const { return 0.25 * s_.skin * s_.skin; }
     void rebuild(bool sort);
     void checkHealth() const;
+    /// The state a force pass reads and writes (sv, sw: the step's mean velocities).
+    ForceContext<D> context(const Vec<D>* sv, const Ang<D>* sw) const;
 
     World<D>& w_;
     TdmSettings s_;
@@ -83,7 +82,7 @@ private:
     std::vector<Vec<D>> wallHistory_;
     std::vector<Vec<D>> xAtBuild_;
     ForceStats stats_;
-    std::unique_ptr<polygon::PolygonScratch> poly_;  ///< 2D scenes with polygons: their force loop's arrays
+    std::unique_ptr<ShapePass> shapes_;  ///< 2D scenes with polygons: their force pass
     std::uint64_t steps_ = 0, rebuilds_ = 0, lastSort_ = 0;
 };
 
