@@ -425,7 +425,7 @@ TEST_F(Cli, HybridRunWritesModesZonesAndColumns) {
 }
 
 // dt = t_c for 8 hot spheres (about 1 m/s) in a closed box: with omega dt = pi the linear spring is unstable
-// (velocity Verlet needs omega dt < 2, PHYSICS.md F.2), every contact pumps energy in, and within some 20 steps an
+// (velocity Verlet needs omega dt < 2, docs/physics.md F.2), every contact pumps energy in, and within some 20 steps an
 // overlap exceeds max_overlap. The run must stop with exit code 3, name the particle and the time, and keep what
 // it wrote before.
 TEST_F(Cli, BlowUpExitsThreeAndKeepsOutputs) {

@@ -1,4 +1,4 @@
-// Binary collisions of the time-driven engine against the analytic results of PHYSICS.md B.2, B.4, C.2.
+// Binary collisions of the time-driven engine against the analytic results of docs/physics.md B.2, B.4, C.2.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,7 +11,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// Expected e with the force clipped at zero (PHYSICS.md B.2, no-attraction variant).
+/// Expected e with the force clipped at zero (docs/physics.md B.2, no-attraction variant).
 double clippedRestitution(double e) {
     const double lne = std::log(e);
     const double w0sq = kPi * kPi + lne * lne;  // in units of 1/t_c^2
@@ -88,7 +88,7 @@ Collision<D> collide(double e, IntegratorKind integ, bool wall, double gtOverGn,
 class HeadOn : public ::testing::TestWithParam<std::tuple<double, IntegratorKind, bool>> {};
 
 // The contact starts at a random point within a time step; the force jump at onset (damping acts at once)
-// makes single collisions scatter by about +-eta dt (PHYSICS.md F.3). The mean over onset phases is the
+// makes single collisions scatter by about +-eta dt (docs/physics.md F.3). The mean over onset phases is the
 // restitution the law produces; each single collision stays within the onset bound.
 TEST_P(HeadOn, RestitutionMatchesClippedLinearLaw) {
     const auto [e, integ, wall] = GetParam();
@@ -117,11 +117,11 @@ INSTANTIATE_TEST_SUITE_P(AllCases, HeadOn,
                                             ::testing::Bool()));
 
 TEST(Collisions, ClippedRestitutionFormula) {
-    // PHYSICS.md B.2: e = 0.9 design gives e* = 0.90203
+    // docs/physics.md B.2: e = 0.9 design gives e* = 0.90203
     EXPECT_NEAR(clippedRestitution(0.9), 0.90203, 1e-5);
 }
 
-/// Walton's rule (PHYSICS.md C.2) with the TDM sticking value beta0.
+/// Walton's rule (docs/physics.md C.2) with the TDM sticking value beta0.
 double walton(double e, double mu, double q, double beta0, double ratio) {
     return std::min(beta0, -1 + mu * (1 + e) * (1 + 1 / q) / ratio);
 }
@@ -132,7 +132,7 @@ TEST(Collisions, ObliqueMatchesWaltonSpheresAndDisks) {
     for (double ratio : {0.1, 0.5, 2.5, 3.0, 5.0, 10.0}) {
         const auto c3 = collide<3>(e, IntegratorKind::Verlet, false, ratio, mu, TangentialLaw::Spring, 0.1);
         const auto c2 = collide<2>(e, IntegratorKind::Verlet, false, ratio, mu, TangentialLaw::Spring, 0.1);
-        // beta0 of the sticking spring: -cos(omega_t t_c) ~ 0.998 (PHYSICS.md B.4 table)
+        // beta0 of the sticking spring: -cos(omega_t t_c) ~ 0.998 (docs/physics.md B.4 table)
         EXPECT_NEAR(c3.beta, walton(eStar, mu, 0.4, 0.99787, ratio), 0.02) << "sphere, gt/gn = " << ratio;
         EXPECT_NEAR(c2.beta, walton(eStar, mu, 0.5, 0.99787, ratio), 0.02) << "disk, gt/gn = " << ratio;
     }

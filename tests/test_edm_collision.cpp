@@ -1,4 +1,4 @@
-// The hard-particle collision operator (PHYSICS.md C.1, C.2): conservation laws and the energy change on random
+// The hard-particle collision operator (docs/physics.md C.1, C.2): conservation laws and the energy change on random
 // states with unequal masses, radii and moments of inertia, pairs and walls, 2D and 3D; Walton's sliding branch.
 #include <gtest/gtest.h>
 
@@ -153,7 +153,7 @@ TEST(EdmCollision, WallRandomStates3D) {
     checkRandomPairs<3>(true, BetaRule::Constant);
 }
 
-// Equal particles: the operator reduces to the eta_n, eta_t form of Luding et al. (PHYSICS.md C.1).
+// Equal particles: the operator reduces to the eta_n, eta_t form of Luding et al. (docs/physics.md C.1).
 TEST(EdmCollision, EqualSpheresMatchLudingForm) {
     Rng rng(5, 3100);
     const double q = 0.4, a = 0.7, m = 2.0;
@@ -207,7 +207,7 @@ TEST(EdmCollision, WallIsTheInfiniteMassLimit) {
     }
 }
 
-// The crossover of Walton's rule (PHYSICS.md C.2): |g_t|/|g_n| = mu (1+e)(1+1/q)/(1+beta0).
+// The crossover of Walton's rule (docs/physics.md C.2): |g_t|/|g_n| = mu (1+e)(1+1/q)/(1+beta0).
 TEST(EdmCollision, WaltonCrossover) {
     const double e = 0.9, mu = 0.5, beta0 = 1.0, q = 0.4;
     const double crossover = mu * (1 + e) * (1 + 1 / q) / (1 + beta0);

@@ -1,4 +1,4 @@
-// One physics (PHYSICS.md A.1): for one material, a binary collision gives the same normal and tangential
+// One physics (docs/physics.md A.1): for one material, a binary collision gives the same normal and tangential
 // restitution whether the time-driven engine integrates the soft contact or the event-driven engine applies its
 // collision operator (Walton's rule with the e the soft law really produces). Same set-up as
 // tests/test_collisions.cpp: linear spring-dashpot e = 0.9 (force clipped at zero), t_c = 10 us, Cundall-Strack
@@ -18,7 +18,7 @@ constexpr double kTc = 1e-5;  // contact duration [s]
 constexpr double kA = 0.01;   // radius [m]
 constexpr double kVn = 0.1;   // normal approach speed [m/s]
 constexpr double kE = 0.9, kMu = 0.5;
-// Walton's sticking value = what the sticking spring gives: -cos(omega_t t_c) (PHYSICS.md B.4 table).
+// Walton's sticking value = what the sticking spring gives: -cos(omega_t t_c) (docs/physics.md B.4 table).
 constexpr double kBeta0 = 0.99787;
 
 template <int D>

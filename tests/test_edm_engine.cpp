@@ -359,7 +359,7 @@ TEST(EdmEngine, PeriodicImagesCollide) {
     EXPECT_NEAR(w.particles.v[0][0], 1, 1e-14);
     EXPECT_NEAR(w.particles.v[1][0], -1, 1e-14);
     EXPECT_NEAR(w.particles.x[0][0], 0.6 - 0.1 + 0.15, 1e-12);
-    // virial r_ij . dp_i = sigma m_eff (1+e) |g_n| = 1 * 0.5 m * 2 * 2 (PHYSICS.md E.2)
+    // virial r_ij . dp_i = sigma m_eff (1+e) |g_n| = 1 * 0.5 m * 2 * 2 (docs/physics.md E.2)
     const double m = w.particles.mass[0];
     EXPECT_NEAR(eng.takeCollisionVirial(), 2 * m, 1e-12 * m);
     EXPECT_EQ(eng.takeCollisionVirial(), 0.0);

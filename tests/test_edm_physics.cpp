@@ -1,6 +1,6 @@
 // Physics of the event-driven engine, short versions (the long ones are in tests/validate/test_edm_validate.cpp):
-// the equation of state of the elastic hard-sphere gas from the collision virial (PHYSICS.md E.1, E.2), and a
-// dissipative heap under gravity that the TC model lets settle (PHYSICS.md A.4, D.7).
+// the equation of state of the elastic hard-sphere gas from the collision virial (docs/physics.md E.1, E.2), and a
+// dissipative heap under gravity that the TC model lets settle (docs/physics.md A.4, D.7).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,5 +1,5 @@
-// Event-time predictions (PHYSICS.md D.2, D.3, D.4, D.6) against brute-force time stepping of the parabolic motion,
-// and the invalid-state rules.
+// Event-time predictions (docs/physics.md D.2, D.3, D.4, D.6) against brute-force time stepping of the parabolic
+// motion, and the invalid-state rules.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -141,7 +141,7 @@ double maxWallPenetration(const World<D>& w) {
 
 namespace haet::testing {
 
-/// Compressibility factor Z = 1 + (sum r_ij . dp_i / t_w) / sum m v^2 (PHYSICS.md E.2) of an elastic smooth
+/// Compressibility factor Z = 1 + (sum r_ij . dp_i / t_w) / sum m v^2 (docs/physics.md E.2) of an elastic smooth
 /// hard-sphere (disk) gas, measured over `collisions` collisions after `equilibrate` collisions per particle;
 /// shell: EdmSettings::shell.
 template <int D>
@@ -166,7 +166,7 @@ double measureZ(int n, double phi, std::uint64_t collisions, double equilibrate,
     return 1 + eng.takeCollisionVirial() / ((t - t0) * mv2);
 }
 
-/// Carnahan-Starling (3D, PHYSICS.md E.1).
+/// Carnahan-Starling (3D, docs/physics.md E.1).
 inline double carnahanStarling(double phi) { return (1 + phi + phi * phi - phi * phi * phi) / std::pow(1 - phi, 3); }
 
 /// n particles of radius 0.5 (unequal when polydisperse) on a lattice filling a closed cubic box at volume

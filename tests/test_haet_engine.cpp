@@ -1,4 +1,4 @@
-// The hybrid engine (PHYSICS.md A, docs/haet.md): one physics in both modes, no particle lost or duplicated when
+// The hybrid engine (docs/physics.md A, docs/haet.md): one physics in both modes, no particle lost or duplicated when
 // modes change, energy and momentum bookkeeping that closes, and pure EDM / pure TDM where the flow is uniformly
 // dilute / dense.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Zone labelling of the hybrid (PHYSICS.md A.2): volume fractions, smoothing, hysteresis, buffer, sticky zones.
+// Zone labelling of the hybrid (docs/physics.md A.2): volume fractions, smoothing, hysteresis, buffer, sticky zones.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Convergence order of the integrators on a damped harmonic oscillator (PHYSICS.md F.1): x'' = -w0^2 x - 2 eta x'.
+// Convergence order of the integrators on a damped harmonic oscillator (docs/physics.md F.1): x'' = -w0^2 x - 2 eta x'.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -65,7 +65,7 @@ TEST(Integrators, GearConvergesAtFifthOrder) {
     const double order = std::log2(e1 / e2);
     EXPECT_GT(order, 4.8) << e1 << " " << e2;
     std::printf("Gear errors: %.3g (100 steps) %.3g (200 steps), order %.2f\n", e1, e2, order);
-    EXPECT_LT(e2, 1e-8);  // PHYSICS.md F.1 table: ~4e-10 at 200 steps/period
+    EXPECT_LT(e2, 1e-8);  // docs/physics.md F.1 table: ~4e-10 at 200 steps/period
 }
 
 TEST(Integrators, VerletConvergesAtSecondOrder) {

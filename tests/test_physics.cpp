@@ -1,6 +1,6 @@
 // Physics checks of the time-driven engine on whole systems (fast versions; the long ones are in tests/validate/):
 // conservation in an elastic gas, a sphere/disk on an incline, Hertz head-on collisions, settling in a box, and
-// independence of the result from the thread count. Targets from PHYSICS.md B and F.
+// independence of the result from the thread count. Targets from docs/physics.md B and F.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -38,7 +38,7 @@ using testing::record;
 // ------------------------------------------------------------------------------------------------------------
 // The gas scenes run Gear5 at dt = t_c/100. At the default t_c/50 the total energy wanders by ~1.5e-4 over 10^5
 // steps (measured, 3D scene): the kink of the force at contact onset, not the integrator order, limits the
-// accuracy (PHYSICS.md F.1, F.3); at t_c/100 it stays below ~3e-5.
+// accuracy (docs/physics.md F.1, F.3); at t_c/100 it stays below ~3e-5.
 
 struct GasResult {
     double maxEnergyDrift = 0;    ///< max over samples of |E - E0| / E0
@@ -106,7 +106,7 @@ TEST(ElasticGas, Gear5EnergyAndMomentumConserved2D) {
 // Friction on (Cundall-Strack spring, mu = 0.5), e = 1: energy is no longer conserved, but every pair force,
 // tangential part included, acts equal and opposite, so the total linear momentum stays put to round-off.
 // (Angular momentum is not checked: orbital angular momentum is not conserved in a periodic box, and the torque
-// rule tau = -a n x F_t of PHYSICS.md B.4 conserves spin + orbital only up to O(overlap/radius) anyway.)
+// rule tau = -a n x F_t of docs/physics.md B.4 conserves spin + orbital only up to O(overlap/radius) anyway.)
 TEST(ElasticGas, FrictionalMomentumConserved) {
     for (const char* file : {"elastic_gas3d.toml", "elastic_gas2d.toml"}) {
         Scenario sc = exampleScenario(file);
@@ -160,7 +160,7 @@ InclineResult incline(double thetaDeg, double mu, TangentialLaw tang, Integrator
     n[D - 1] = 1;
     t[0] = 1;
     w.domain.gravity = t * (g * std::sin(theta)) - n * (g * std::cos(theta));
-    // Start at the static overlap m g cos(theta) / k_n of the linear law (PHYSICS.md B.2, m_eff = m on a wall).
+    // Start at the static overlap m g cos(theta) / k_n of the linear law (docs/physics.md B.2, m_eff = m on a wall).
     const double kOverM = (kPi * kPi + std::log(e) * std::log(e)) / (tc * tc);
     const double delta0 = g * std::cos(theta) / kOverM;
     w.particles.add(n * (a - delta0), Vec<D>::zero(), Ang<D>::zero(), a, rho, 0, 0);
@@ -257,7 +257,7 @@ INSTANTIATE_TEST_SUITE_P(Integrators, Incline, ::testing::Values(IntegratorKind:
                          });
 
 // ------------------------------------------------------------------------------------------------------------
-// 3. Hertz head-on collisions (PHYSICS.md B.3)
+// 3. Hertz head-on collisions (docs/physics.md B.3)
 // ------------------------------------------------------------------------------------------------------------
 
 struct HertzMaterial {

@@ -1,5 +1,5 @@
 // Geometry of convex polygons (src/polygon/geometry.hpp) and the pair law's symmetry (src/polygon/contact.hpp):
-// closed forms of regular n-gons (PHYSICS.md G.1), overlap areas against an independent exact construction and
+// closed forms of regular n-gons (docs/physics.md G.1), overlap areas against an independent exact construction and
 // Monte Carlo (G.2), the exact area rate against finite differences, degenerate contacts, Newton's third law and
 // the torque balance (G.3).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Whole-system checks of the polygon contact law in the time-driven engine (PHYSICS.md G.3, F.1, F.3): a block at
+// Whole-system checks of the polygon contact law in the time-driven engine (docs/physics.md G.3, F.1, F.3): a block at
 // rest on the floor carries its weight with the static overlap Y A / l = m g; a block on an incline sticks while
 // tan(theta) < mu and otherwise slides with a = g (sin(theta) - mu cos(theta)); polygons and disks together.
 #include <gtest/gtest.h>
@@ -234,7 +234,7 @@ TEST(PolygonIncline, BlockSlidesBeyondTheFrictionAngle) {
 // ------------------------------------------------------------------------------------------------------------
 // Energy: elastic, frictionless collisions with Gear5
 // ------------------------------------------------------------------------------------------------------------
-// The overlap-area law has no potential in general (PHYSICS.md G.3): with rotation, or an offset approach, the
+// The overlap-area law has no potential in general (docs/physics.md G.3): with rotation, or an offset approach, the
 // energy after a collision differs from the energy before even when the collision is integrated exactly (the
 // change converges as dt -> 0 to a nonzero value: 4e-3 of the pair's energy on average, up to 6e-2, over 200
 // random collisions, tests/validate/validate_polygons.cpp). What the
@@ -242,7 +242,7 @@ TEST(PolygonIncline, BlockSlidesBeyondTheFrictionAngle) {
 // within 1e-3 of the one a 16 times smaller step gives. A flat head-on collision (no torque) has a potential and
 // conserves energy; its face-on onset is a kink of the force (A grows linearly with the depth), which limits the
 // accuracy at the polygon step to a few 1e-3 (measured 5e-3 with Gear, 3e-4 with Verlet; the error depends on the
-// phase of the onset within a step, PHYSICS.md F.3), so it is checked at a 16 times smaller step.
+// phase of the onset within a step, docs/physics.md F.3), so it is checked at a 16 times smaller step.
 TEST(PolygonEnergy, GearIntegratesEachCollisionLikeASmallStep) {
     double worstIntegration = 0, worstLaw = 0;
     for (std::uint64_t seed = 1; seed <= 12; ++seed) {

@@ -1,5 +1,5 @@
 #pragma once
-// Contact laws as pure functions of explicit inputs (PHYSICS.md B). One law serves particle-particle and
+// Contact laws as pure functions of explicit inputs (docs/physics.md B). One law serves particle-particle and
 // particle-wall contacts: a wall is a partner of infinite mass and radius (m_eff = m, R_eff = a).
 #include <cmath>
 #include <cstring>
@@ -26,7 +26,7 @@ struct PairCoeffs {
     double ktConst = 0;    ///< fixed k_t [N/m]
     double gtPerMeff = 0;  ///< gamma_t / m_eff [1/s]
     double mu = 0;         ///< Coulomb friction [-]
-    // Collision-operator view of the same pair (event-driven engine, PHYSICS.md A.1, C)
+    // Collision-operator view of the same pair (event-driven engine, docs/physics.md A.1, C)
     double restitution = 1;  ///< e that the soft law produces (incl. the contact-ending rule)
     double beta0 = 1;        ///< Walton's sticking tangential restitution
 };
@@ -139,7 +139,7 @@ struct HertzViscoNormal {
 };
 
 /// Hertz with Tsuji damping: F = k_H delta^{3/2} + alpha sqrt(2 m_eff k_H) delta^{1/4} delta_dot, k_H = hertzK sqrt(R).
-/// The mass in the damping is 2 m_eff: Tsuji's alpha(e) fit assumes the particle mass (PHYSICS.md B.3 pitfall).
+/// The mass in the damping is 2 m_eff: Tsuji's alpha(e) fit assumes the particle mass (docs/physics.md B.3 pitfall).
 struct HertzTsujiNormal {
     template <class C, class S>
     static NormalResultOf<S> eval(const C& c, S delta, S deltaDot, S meff, S reff) {

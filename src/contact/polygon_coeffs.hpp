@@ -9,7 +9,7 @@ namespace haet::polygon {
 /// Coefficients of the polygon law for one material pair (built once, contact/setup.cpp).
 struct PolygonCoeffs {
     double young = 0;                          ///< Y [N/m] (2D: stiffness per length), F_el = Y A / l
-    double gamma = 0;                          ///< normal damping, dimensionless (PHYSICS.md G.3)
+    double gamma = 0;                          ///< normal damping, dimensionless (docs/physics.md G.3)
     double kt = 0;                             ///< tangential spring stiffness [N/m]; 0 = no tangential force
     double gammaT = 0;                         ///< tangential damping: F = -gammaT sqrt(k_t m_t) g_t [-]
     double mu = 0;                             ///< Coulomb friction [-]

@@ -273,7 +273,7 @@ ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<Mate
         s.contactTimeNote =
             "Hertz: t_c = 2.868 (m_eff^2/(R_eff E_eff^2 v))^(1/5) of the smallest pair at impact_velocity";
 
-    // Polygons: the thesis rule dt = (pi/10) sqrt(m_min/Y) (PHYSICS.md F.3), with the stiffest pair's Y; their
+    // Polygons: the thesis rule dt = (pi/10) sqrt(m_min/Y) (docs/physics.md F.3), with the stiffest pair's Y; their
     // contact time is about ten such steps. The rule assumes light damping: the Gear corrector sees the damping
     // force through the predicted velocity and turns unstable once the damping rate per step, gamma (w/l)
     // sqrt(Y/m) dt, exceeds about 0.15 (damped oscillator: stable at 2 zeta omega dt = 0.12, unstable at 0.18; a

@@ -31,10 +31,10 @@ struct ContactSetup {
     double contactTime = 0;         ///< shortest contact duration among particle pairs and walls [s]
     std::string contactTimeNote;    ///< how contactTime was obtained (for `haet check`)
 
-    /// Overlap-area law of polygon contacts (PHYSICS.md G.3), nMaterials x nMaterials; used for every contact
+    /// Overlap-area law of polygon contacts (docs/physics.md G.3), nMaterials x nMaterials; used for every contact
     /// that involves a polygon. Y_ab = 2 Y_a Y_b / (Y_a + Y_b) from the materials' `young`.
     std::vector<polygon::PolygonCoeffs> polygonTable;
-    /// Polygon time-step rule (PHYSICS.md F.3): (pi/10) sqrt(m_min / Y_max) over polygon particles [s]; 0 when the
+    /// Polygon time-step rule (docs/physics.md F.3): (pi/10) sqrt(m_min / Y_max) over polygon particles [s]; 0 when the
     /// scene has no polygon.
     double polygonStep = 0;
     double polygonStepFactor = 1;  ///< the factor min(1, 0.2/gamma) in polygonStep (strong damping) [-]
@@ -54,7 +54,7 @@ template <int D>
 ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<MaterialProps>& materials,
                                const std::vector<MaterialStats>& stats);
 
-/// Result of integrating one head-on collision of the soft law (PHYSICS.md B.2/B.3).
+/// Result of integrating one head-on collision of the soft law (docs/physics.md B.2/B.3).
 struct HeadOnResult {
     double restitution;  ///< -g_n after / g_n before
     double duration;     ///< contact duration [s]

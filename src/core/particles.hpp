@@ -16,7 +16,7 @@ enum ParticleFlag : std::uint8_t {
     kFrozen = 1u << 0,  ///< not integrated: position and velocity stay as given (a rough base, a fixture)
 };
 
-/// Shape factor q of the moment of inertia I = q m a^2 (PHYSICS.md B.4): solid disk 1/2, solid sphere 2/5.
+/// Shape factor q of the moment of inertia I = q m a^2 (docs/physics.md B.4): solid disk 1/2, solid sphere 2/5.
 template <int D>
 inline constexpr double kInertiaFactor = (D == 2) ? 0.5 : 0.4;
 
@@ -61,7 +61,7 @@ struct Particles {
     ShapeTable shapes;                 ///< never permuted: particles point into it
 
     /// Particles [0, tdmCount()) are integrated by the time-driven engine. In a hybrid run the rest belong to the
-    /// event-driven engine (PHYSICS.md A); in a pure run one engine owns them all (the default: every particle).
+    /// event-driven engine (docs/physics.md A); in a pure run one engine owns them all (the default: every particle).
     std::size_t nTdm = static_cast<std::size_t>(-1);
 
     std::size_t size() const { return id.size(); }

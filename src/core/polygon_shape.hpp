@@ -32,7 +32,7 @@ struct Moments {
     double inertiaPerMass = 0;  ///< I about the centroid divided by the mass [m^2]
 };
 
-/// PHYSICS.md G.1. Computed relative to the first vertex, which keeps the round-off relative to the polygon's
+/// docs/physics.md G.1. Computed relative to the first vertex, which keeps the round-off relative to the polygon's
 /// size even far from the origin.
 inline Moments polygonMoments(const V2* v, int n) {
     const V2 o = v[0];

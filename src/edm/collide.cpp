@@ -1,5 +1,5 @@
-// The collisions of the event-driven engine: the rough-particle collision operator (edm/collision.hpp, PHYSICS.md C)
-// applied to a pair or a particle and a wall at the time of its event, with the TC model (edm/tc_model.hpp) and the
+// The collisions of the event-driven engine: the rough-particle collision operator (edm/collision.hpp, docs/physics.md
+// C) applied to a pair or a particle and a wall at the time of its event, with the TC model (edm/tc_model.hpp) and the
 // rest hop (docs/edm.md).
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 #pragma once
-// The rough-particle hard collision operator of the event-driven engine (PHYSICS.md C.1) with the tangential
+// The rough-particle hard collision operator of the event-driven engine (docs/physics.md C.1) with the tangential
 // restitution from Walton's rule or a constant (C.2). One operator serves pairs and walls: a wall, like a frozen
 // particle, is a body of zero inverse mass and inertia moving with its own velocity.
 //
@@ -32,7 +32,7 @@ inline double kineticEnergy(const CollisionBody<D>& b) {
     return e;
 }
 
-/// How beta is chosen (PHYSICS.md C.2).
+/// How beta is chosen (docs/physics.md C.2).
 enum class BetaRule {
     Walton,    ///< beta = min(beta0, -1 + mu (1+e) (m_eff/m_t) |g_n|/|g_t|): sticking or Coulomb sliding
     Constant,  ///< beta = beta0 always
@@ -53,12 +53,12 @@ struct CollisionImpulse {
     double gn = 0;         ///< normal relative velocity of the contact points before [m/s] (< 0 approaching)
     Vec<D> gt;             ///< tangential relative velocity of the contact points before [m/s]
     double meff = 0;       ///< normal effective mass [kg]
-    double mt = 0;         ///< tangential effective mass [kg] (PHYSICS.md B.4)
+    double mt = 0;         ///< tangential effective mass [kg] (docs/physics.md B.4)
     double e = 1;          ///< normal restitution used [-]
     double beta = -1;      ///< tangential restitution used [-]
     bool sliding = false;  ///< Walton's Coulomb branch was taken
 
-    /// Change of kinetic energy, PHYSICS.md C.1: -1/2 m_eff (1-e^2) g_n^2 - 1/2 m_t (1-beta^2) |g_t|^2 [J].
+    /// Change of kinetic energy, docs/physics.md C.1: -1/2 m_eff (1-e^2) g_n^2 - 1/2 m_t (1-beta^2) |g_t|^2 [J].
     double energyChange() const {
         return -0.5 * meff * (1 - e * e) * gn * gn - 0.5 * mt * (1 - beta * beta) * norm2(gt);
     }
@@ -70,7 +70,7 @@ Vec<D> contactVelocity(const CollisionBody<D>& b1, const CollisionBody<D>& b2, c
     return b1.v - b2.v - cross(b1.w * b1.radius + b2.w * b2.radius, n);
 }
 
-/// Walton's tangential restitution (PHYSICS.md C.2). kappa = m_eff / m_t = 1 + m_eff sum a^2/I.
+/// Walton's tangential restitution (docs/physics.md C.2). kappa = m_eff / m_t = 1 + m_eff sum a^2/I.
 inline double waltonBeta(double e, double mu, double beta0, double kappa, double gnAbs, double gtAbs) {
     if (!(gtAbs > 0)) return beta0;
     return std::min(beta0, -1 + mu * (1 + e) * kappa * gnAbs / gtAbs);
@@ -107,7 +107,7 @@ CollisionImpulse<D> collisionImpulse(const CollisionBody<D>& b1, const Collision
     return r;
 }
 
-/// Applies impulse P (on body 1, -P on body 2) at the contact point, PHYSICS.md C.1:
+/// Applies impulse P (on body 1, -P on body 2) at the contact point, docs/physics.md C.1:
 /// v1 += P/m1, v2 -= P/m2, w1 -= (a1/I1) n x P, w2 -= (a2/I2) n x P.
 template <int D>
 void applyImpulse(CollisionBody<D>& b1, CollisionBody<D>& b2, const Vec<D>& n, const Vec<D>& P) {

@@ -327,7 +327,7 @@ bool EdmEngine<D>::keepsColl(std::uint32_t s) const {
 }
 
 // The time of slot s's kept event, recomputed at a crossing (now) in the canonical form, so the same bits as when the
-// scan found it, unless a synchronisation has rounded the stored states since or the state is invalid (PHYSICS.md
+// scan found it, unless a synchronisation has rounded the stored states since or the state is invalid (docs/physics.md
 // D.6: decided afresh from the state now); docs/edm.md, "Canonical arithmetic". The partner's periodic
 // image is the minimum image now: the pair approaches, so the two are no farther apart than when the scan found them
 // in neighbouring cells (sqrt(D) times two cell edges), which is less than half the box with 7 cells per axis.

@@ -1,5 +1,5 @@
 #pragma once
-// Event-driven engine for hard disks (D = 2) and spheres (D = 3): Lubachevsky's scheme (PHYSICS.md D.1) with
+// Event-driven engine for hard disks (D = 2) and spheres (D = 3): Lubachevsky's scheme (docs/physics.md D.1) with
 // one pending event per particle, collision counters for stale events, per-particle clocks (lazy updates),
 // neighbour shells (a list per particle of those it can reach while it stays near where the list was made) or a
 // cell grid with cell-crossing events, periodic images, moving plane walls, gravity, frozen particles, the
@@ -43,7 +43,7 @@ struct EdmSettings {
     double shell = 0;
     /// Tangential restitution: Walton's rule with (e, mu, beta0) of the material pair, or beta = beta0 always.
     enum class Tangential { Walton, Constant } tangential = Tangential::Walton;
-    /// TC model (PHYSICS.md A.4, D.7): a collision less than tcTime after the previous collision of either
+    /// TC model (docs/physics.md A.4, D.7): a collision less than tcTime after the previous collision of either
     /// particle is elastic (e = 1, beta = -1). Also enables the rest hop on walls and frozen particles.
     bool tcModel = true;
     /// TC model time [s]; 0: the TDM contact duration world.contact.contactTime.
@@ -146,7 +146,7 @@ public:
     std::uint64_t events() const { return events_; }  ///< events processed (collisions, crossings, stale)
     std::uint64_t collisions() const { return stats_.pairCollisions + stats_.wallCollisions; }
     const EdmStats& stats() const { return stats_; }
-    /// Sum of r_ij . dp_i over pair collisions since the last call [J] (PHYSICS.md E.2); walls excluded.
+    /// Sum of r_ij . dp_i over pair collisions since the last call [J] (docs/physics.md E.2); walls excluded.
     double takeCollisionVirial() {
         const double v = virial_;
         virial_ = 0;

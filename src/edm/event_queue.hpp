@@ -1,5 +1,5 @@
 #pragma once
-// Priority structures over N particle slots, one pending event time per slot (PHYSICS.md D.1, D.5).
+// Priority structures over N particle slots, one pending event time per slot (docs/physics.md D.1, D.5).
 // All three give the same answer: the slot with the smallest time, ties broken by the lower slot index.
 //
 //  * EventTree: complete binary (tournament) tree, Marin, Risso & Cordero, J. Comput. Phys. 109, 306 (1993).

@@ -1,5 +1,5 @@
 #pragma once
-// What the event-driven engine tells an engine coupled to it (the hybrid, haet/engine.hpp; PHYSICS.md A.2-A.4)
+// What the event-driven engine tells an engine coupled to it (the hybrid, haet/engine.hpp; docs/physics.md A.2-A.4)
 // about where its particles are: it reports every particle joining, leaving and crossing a cell of its event grid,
 // and collisions within the TC time. The coupled engine keeps whatever it needs per cell (zone volumes, a guard of
 // cells near its own particles, the occupants of those cells) from these reports and the grid's geometry; it reads

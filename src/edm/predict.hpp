@@ -1,12 +1,12 @@
 #pragma once
-// Event-time predictions of the event-driven engine as pure functions (PHYSICS.md D.2, D.3, D.4, D.6).
+// Event-time predictions of the event-driven engine as pure functions (docs/physics.md D.2, D.3, D.4, D.6).
 //
 // Every prediction reduces to one question: given a "gap" f(t) that is >= 0 while the state is valid
 // (distance minus contact distance, height above a wall, distance to a cell face), when does f first fall
 // through zero? For ballistic relative motion f is the quadratic f0 + f1 t + f2 t^2/2; only a moving particle
 // against a fixed sphere under gravity gives a quartic (firstRootQuartic).
 //
-// Invalid states (PHYSICS.md D.6): round-off can leave f0 slightly negative (overlap, beyond a wall, outside a
+// Invalid states (docs/physics.md D.6): round-off can leave f0 slightly negative (overlap, beyond a wall, outside a
 // cell). Such a state is given a dynamics instead of an error: if f decreases now, the event is now (t = 0);
 // if it increases (receding), there is no event until f has come back and falls again. The smaller root of
 // the quadratic (the "exit" time of an overlapping pair) is never used.
@@ -22,7 +22,7 @@ namespace haet {
 inline constexpr double kNever = std::numeric_limits<double>::infinity();
 
 /// First time t >= 0 at which f(t) = f0 + f1 t + f2 t^2 / 2 falls through zero, kNever if never
-/// (PHYSICS.md D.3, DynamO's root selection in stable form: no cancellation in any branch).
+/// (docs/physics.md D.3, DynamO's root selection in stable form: no cancellation in any branch).
 ///  * f2 < 0 (accelerating towards the face, e.g. a floor under gravity): there is always an event.
 ///  * f2 > 0 (accelerating away, e.g. a ceiling; or a pair, f2 = 2|v|^2): only if approaching now.
 ///  * f2 = 0: only if f1 < 0.
@@ -48,7 +48,7 @@ inline constexpr double kNever = std::numeric_limits<double>::infinity();
 }
 
 /// Collision time of two spheres (disks) from their relative position r = r_i - r_j and relative velocity
-/// v = v_i - v_j at a common time, sigma = a_i + a_j (PHYSICS.md D.2). Under a common gravity the relative
+/// v = v_i - v_j at a common time, sigma = a_i + a_j (docs/physics.md D.2). Under a common gravity the relative
 /// motion is ballistic, so this holds with gravity too. Returns the time after that common time, or kNever.
 /// Symmetric: (r, v) and (-r, -v) give bit-identical results.
 template <int D>
@@ -61,7 +61,7 @@ double pairCollisionTime(const Vec<D>& r, const Vec<D>& v, double sigma) {
     return firstRootFalling(c, 2 * b, 2 * v2);
 }
 
-/// Time until a particle of radius a hits a plane wall (PHYSICS.md D.3). All vectors at a common time:
+/// Time until a particle of radius a hits a plane wall (docs/physics.md D.3). All vectors at a common time:
 /// x, v: particle position and velocity; p, u: a point of the plane and the plane's velocity; n: unit normal
 /// into the domain; g: the particle's acceleration (gravity). Returns the time after that common time, or kNever.
 template <int D>
@@ -70,7 +70,7 @@ double wallCollisionTime(const Vec<D>& x, const Vec<D>& v, double a, const Vec<D
     return firstRootFalling(dot(n, x - p) - a, dot(n, v - u), dot(n, g));
 }
 
-/// Time until a coordinate x (velocity v, acceleration g) leaves the interval [lo, hi] (PHYSICS.md D.4),
+/// Time until a coordinate x (velocity v, acceleration g) leaves the interval [lo, hi] (docs/physics.md D.4),
 /// and through which face: up = true for hi. Infinite bounds are allowed (outermost cells of open axes).
 /// Under gravity the particle may turn around inside the interval; the quadratic covers that.
 struct CellExit {

@@ -1,7 +1,7 @@
 #pragma once
 // The event-driven engine's particle state, shared by its parts (the event loop, the event grid, the neighbour
 // shells, the candidate scan, the reference twin): per slot the records a prediction reads, the motion between
-// events and the canonical pair and wall times (PHYSICS.md D.2-D.4, D.6; docs/edm.md, "Canonical arithmetic").
+// events and the canonical pair and wall times (docs/physics.md D.2-D.4, D.6; docs/edm.md, "Canonical arithmetic").
 //
 // The engine works on slots, its own order of the particles (cell by cell, for memory locality); Rec::idx maps a
 // slot to the particle's index in the World. What a prediction reads of a neighbour is in two records: Hot (one
@@ -158,7 +158,7 @@ struct Slots {
     }
 
     // A root before now means an invalid state at the stored clocks (an overlap that round-off, or a bug, let
-    // pass). Its dynamics are decided by the state now (PHYSICS.md D.6): approaching now -> now; receding -> the
+    // pass). Its dynamics are decided by the state now (docs/physics.md D.6): approaching now -> now; receding -> the
     // next root from now. Deciding from the older state could schedule a collision that the collision then finds
     // receding.
     double pairTimeFromNow(std::uint32_t a, std::uint32_t b, const Shift& m, double now) const;

@@ -1,5 +1,5 @@
 #pragma once
-// The TC model against inelastic collapse (Luding & McNamara 1998; PHYSICS.md A.4, D.7; docs/edm.md): a collision
+// The TC model against inelastic collapse (Luding & McNamara 1998; docs/physics.md A.4, D.7; docs/edm.md): a collision
 // less than the TC time after the previous collision of either particle is elastic (e = 1, beta = -1), and against a
 // fixed obstacle that gravity pushes a particle into, the normal speed after a collision is at least |n.g| t_c (the
 // rest hop: a flight of 2 t_c instead of coming to rest through infinitely many collisions).

@@ -1,5 +1,5 @@
 #pragma once
-// The hybrid's book of its event-driven particles (PHYSICS.md A.2-A.4, docs/haet.md): it is the EdmObserver
+// The hybrid's book of its event-driven particles (docs/physics.md A.2-A.4, docs/haet.md): it is the EdmObserver
 // (edm/observer.hpp) of the hybrid's event-driven engine, so the engine tells it every particle joining, leaving
 // and crossing a cell of its event grid, and every collision within the TC time; from that it keeps what the hybrid
 // asks per cell of that grid: the particle volume per zone (for the zone labels), the particles that entered a

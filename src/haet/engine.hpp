@@ -1,5 +1,5 @@
 #pragma once
-// The hybrid (PHYSICS.md A, docs/haet.md): time-driven DEM where the flow is dense, event-driven dynamics where it
+// The hybrid (docs/physics.md A, docs/haet.md): time-driven DEM where the flow is dense, event-driven dynamics where it
 // is dilute, on one particle store. Particles [0, tdmCount()) are the time-driven engine's, the rest the
 // event-driven engine's; a particle changes mode by exchanging places with the first (or last) particle of the
 // other range, so a mode change costs O(1) in the store plus a pair-list rebuild, never a copy of the system.
@@ -22,7 +22,7 @@
 namespace haet {
 
 struct HaetSettings {
-    ZoneSettings zones;     ///< zone edge, phi_on / phi_off, buffer (PHYSICS.md A.2)
+    ZoneSettings zones;     ///< zone edge, phi_on / phi_off, buffer (docs/physics.md A.2)
     int relabelEvery = 50;  ///< zones are re-labelled, and particles change mode, every this many steps [steps];
                             ///< the guard follows the TDM particles at every pair-list build
     int diluteSteps = 20;   ///< a time-driven particle without contacts returns to EDM once its zone has been

@@ -1,5 +1,5 @@
 #pragma once
-// Zone labels of the hybrid (PHYSICS.md A.2): a uniform grid over the box; each zone is dense (time-driven) or
+// Zone labels of the hybrid (docs/physics.md A.2): a uniform grid over the box; each zone is dense (time-driven) or
 // dilute (event-driven) from its smoothed local volume fraction, with hysteresis, sticky zones (enduring
 // contacts, particles resting on walls) and a buffer of dense-adjacent zones.
 #include <array>

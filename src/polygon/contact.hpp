@@ -1,5 +1,5 @@
 #pragma once
-// The overlap-area contact law of 2D polygons (Matuttis & Chen; PHYSICS.md G.3), as a pure function of the overlap
+// The overlap-area contact law of 2D polygons (Matuttis & Chen; docs/physics.md G.3), as a pure function of the overlap
 // geometry and the two bodies' motion. One law serves polygon-polygon, polygon-disk and polygon-wall contacts.
 //
 //   normal n        perpendicular to the chord c (c: body i's outline inside body j, geometry.hpp), from j to i
@@ -173,7 +173,7 @@ template <class Law, bool kFriction>
 }
 
 /// Elastic energy of a contact [J]. The potential law's is exact, Y A^2 / (2 L^2). The overlap-area law has no
-/// potential (PHYSICS.md G.3); its energy is estimated as Y A^2 / (2 l |c|): exact for a flat contact
+/// potential (docs/physics.md G.3); its energy is estimated as Y A^2 / (2 l |c|): exact for a flat contact
 /// (A = |c| depth), 3/4 of the work done for a vertex contact (A ~ depth^2).
 template <class Law>
 inline double polygonContactEnergy(const PolygonCoeffs& c, const Overlap& o, const ContactForce& f,

@@ -1,10 +1,10 @@
 #pragma once
-// Contact geometry of 2D convex polygons (PHYSICS.md G.2; their shapes and moments: core/polygon_shape.hpp): the
+// Contact geometry of 2D convex polygons (docs/physics.md G.2; their shapes and moments: core/polygon_shape.hpp): the
 // separating-axis test, the overlap of two convex polygons by Sutherland-Hodgman clipping,
 // the overlap of a circle and a convex polygon, and the overlap of a polygon with a half-plane (a wall).
 //
 // Every overlap routine also returns the two quantities the force law needs besides area and centroid
-// (PHYSICS.md G.3):
+// (docs/physics.md G.3):
 //  - the chord c: the sum of the edge vectors of the overlap's boundary that lie on the first body's outline,
 //    counter-clockwise. With two outline intersection points S1, S2 it is S2 - S1, and the contact normal is
 //    perpendicular to it. It is also the gradient of the overlap area: translating the first body by t changes
@@ -49,7 +49,7 @@ struct VertexBuffer {
 // ---- separating axes ----
 
 /// True when some edge of P or Q separates the two convex counter-clockwise polygons (touching counts as
-/// separated: the overlap area is zero). PHYSICS.md G.4.
+/// separated: the overlap area is zero). docs/physics.md G.4.
 inline bool separated(const V2* P, int np, const V2* Q, int nq) {
     auto byEdgesOf = [](const V2* A, int na, const V2* B, int nb) {
         for (int k = 0; k < na; ++k) {

@@ -126,7 +126,7 @@ public:
     std::size_t contacts() const override { return 0; }
     double maxOverlapRatio() const override { return 0; }
     double elasticEnergy() const override { return 0; }
-    /// Collision virial (PHYSICS.md E.2): sum of r_ij . dp_i over the window, divided by its length.
+    /// Collision virial (docs/physics.md E.2): sum of r_ij . dp_i over the window, divided by its length.
     double virial(double window) override {
         const double v = eng_.takeCollisionVirial();
         return window > 0 ? v / window : 0.0;
@@ -580,7 +580,7 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
         out << fmt::format("polygons   {} ({}; the rest are disks)\n", world.particles.shapes.size(),
                            sc.contact.polygonLaw == PolygonLaw::Potential
                                ? "potential law Y A |c| / L^2 at the chord midpoint, energy-conserving"
-                               : "overlap-area law Y A / l, PHYSICS.md G.3");
+                               : "overlap-area law Y A / l, docs/physics.md G.3");
     out << fmt::format("contact    {} normal law, {} tangential; contact duration t_c = {:.4g} s ({})\n",
                        sc.contact.normal == NormalLaw::Linear ? "linear" : "hertz",
                        sc.contact.tangential == TangentialLaw::Spring ? "spring" : "no", world.contact.contactTime,

@@ -82,13 +82,13 @@ enum class EdmTangential { Walton, Constant };
 struct EdmDef {
     /// Tangential restitution: Walton's rule with (e, mu, beta0) of the materials, or beta = beta0 always.
     EdmTangential tangential = EdmTangential::Walton;
-    bool tcModel = true;             ///< inelastic-collapse protection (TC model, PHYSICS.md D.7)
+    bool tcModel = true;             ///< inelastic-collapse protection (TC model, docs/physics.md D.7)
     std::optional<double> tcTime;    ///< TC time [s]; default: the soft contact duration t_c
     std::optional<double> cellSize;  ///< event grid cell edge [m]; default: the largest diameter
     SourcePos pos;
 };
 
-/// The hybrid (method = "haet"), PHYSICS.md A: TDM where the local volume fraction is high, EDM where low.
+/// The hybrid (method = "haet"), docs/physics.md A: TDM where the local volume fraction is high, EDM where low.
 struct HaetDef {
     std::optional<double> zoneSize;  ///< zone cell edge [m]; default 4 x the largest diameter
     std::optional<double> phiOn;     ///< a zone turns dense above this volume (area) fraction [-]
@@ -121,7 +121,7 @@ struct InsertDef {
     std::string file;  ///< arrangement = File: path (resolved against the scenario dir)
     FileFormat format = FileFormat::Csv;
     std::vector<int> frozenTypes;  ///< LAMMPS data files: atom types (1-based) whose particles are frozen
-    // Polygons (2D, PHYSICS.md G). `radius` is then the circumradius about the centroid (the bounding circle).
+    // Polygons (2D, docs/physics.md G). `radius` is then the circumradius about the centroid (the bounding circle).
     ShapeKind shape = ShapeKind::Disk;
     PolygonKind polygon = PolygonKind::Regular;
     int sidesMin = 0, sidesMax = 0;     ///< vertices per polygon, uniform in [min, max] (regular: min = max)

@@ -242,7 +242,7 @@ void Gear5<D>::restart(const Particles<D>& p, std::size_t i, double dt) {
         for (auto& a : r_) a.resize(p.tdmCount(), Ang<D>::zero());
     }
     // Higher derivatives from the current force with zero jerk: exact for free flight under gravity, and the
-    // best local guess for a particle not yet in contact (PHYSICS.md F.1).
+    // best local guess for a particle not yet in contact (docs/physics.md F.1).
     const double h2 = 0.5 * dt * dt;
     y_[0][i] = p.f[i] * (p.invMass[i] * h2);
     r_[0][i] = p.torque[i] * (p.invInertia[i] * h2);

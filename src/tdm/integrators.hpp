@@ -1,5 +1,5 @@
 #pragma once
-// Time integrators for the time-driven engine (PHYSICS.md F). Each step is predict -> forces -> correct:
+// Time integrators for the time-driven engine (docs/physics.md F). Each step is predict -> forces -> correct:
 // predict() moves positions and velocities to t + dt (velocities as the estimate the velocity-dependent forces
 // see) and reports each particle's mean velocity over the step (displacement / dt), which drives the tangential
 // spring so that its elongation is the true relative displacement of the contact points; correct() applies the
@@ -164,7 +164,7 @@ public:
     void remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) override;
 
     /// Sets the scaled higher derivatives of particle i from unscaled ones (a, jerk, snap, crackle):
-    /// consistent start-up when the caller knows them (PHYSICS.md F.1 start-up pitfall).
+    /// consistent start-up when the caller knows them (docs/physics.md F.1 start-up pitfall).
     void setDerivatives(std::size_t i, const Vec<D>& a, const Vec<D>& j3, const Vec<D>& j4, const Vec<D>& j5,
                         double dt);
 

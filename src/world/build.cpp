@@ -74,7 +74,7 @@ TdmSettings tdmSettings(const Scenario& sc, const World<D>& w, std::string* dtNo
     std::size_t polygons = 0;
     if constexpr (D == 2)
         for (std::size_t i = 0; i < p.size(); ++i) polygons += p.isPolygon(i);
-    // Polygons: Gear's predictor-corrector unless the scenario names an integrator (PHYSICS.md F.3).
+    // Polygons: Gear's predictor-corrector unless the scenario names an integrator (docs/physics.md F.3).
     if (polygons > 0 && !sc.tdm.integratorGiven) s.integrator = IntegratorKind::Gear5;
     s.maxOverlap = sc.tdm.maxOverlap;
     s.sortEvery = sc.tdm.sortEvery;

@@ -19,7 +19,7 @@ void record(const std::string& key, double value) {
     ::testing::Test::RecordProperty(key, buf);
 }
 
-// ---- equation of state: Z from the collision virial against Carnahan-Starling within 1.5 % (PHYSICS.md E.1) ----
+// ---- equation of state: Z from the collision virial against Carnahan-Starling within 1.5 % (docs/physics.md E.1) ----
 
 void zAgainstCarnahanStarling(double phi, double shell = 0) {
     const double z = testing::measureZ<3>(1000, phi, 2000000, 50, 21, shell);

@@ -26,7 +26,7 @@ using testing::record;
 // Gear at the polygon time step against a 16 times smaller step, over 200 random collisions: the energy after a
 // collision agrees within 1e-3 of the pair's energy for at least 97 % of them, and within 5e-3 for all (measured:
 // 197 of 200 within 1e-3, worst 3.0e-3; the few beyond are contacts whose onset is nearly face-on, a kink of the
-// force that Gear resolves only at smaller steps, PHYSICS.md F.3). The converged change itself is the law's (G.3).
+// force that Gear resolves only at smaller steps, docs/physics.md F.3). The converged change itself is the law's (G.3).
 TEST(PolygonEnergyLong, GearIntegratesCollisionsLikeASmallStep) {
     double worstIntegration = 0, meanIntegration = 0, worstLaw = 0, meanLaw = 0;
     int beyond = 0;
@@ -87,7 +87,7 @@ TEST(PolygonEnergyLong, OverlapAreaLawEnergyChangeShrinksWithStiffness) {
 // time step, Y = 1e4 N/m (overlaps up to a few % of the size). The energy is read at instants without any contact,
 // where it is purely kinetic. With the potential law (polygon_law = "potential") the drift stays within the 1e-3
 // goal: the law conserves energy, what remains is Gear's error at each contact onset. The overlap-area law of
-// PHYSICS.md G.3 is not conservative (a collision with spin or an offset approach changes the pair's energy by
+// docs/physics.md G.3 is not conservative (a collision with spin or an offset approach changes the pair's energy by
 // 4e-3 on average, PolygonEnergyLong above), and the same gas drifts by about 1e-2: its bound, 2e-2, only catches a
 // broken integration or a blow-up.
 TEST(PolygonEnergyLong, GasEnergyAtContactFreeInstants) {
