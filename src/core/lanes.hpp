@@ -247,8 +247,8 @@ inline LaneIndex loadIndex(const std::uint32_t* p) {
     return r;
 }
 
-/// base[idx[l]] in lane l: four loads put side by side. (The AVX2 gather instructions are slow on AMD Zen 4: with
-/// them, here and below, the 3D chute's step took a third more time; bench/README.md, "Partners prefetched".)
+/// base[idx[l]] in lane l: four loads put side by side. (The AVX2 gather instructions are slow on AMD Zen 4, where
+/// they made the 3D chute's step markedly slower; bench/README.md, "Partners prefetched".)
 inline Lanes gather(const double* base, LaneIndex idx) {
 #ifdef __AVX__
     const __m128d lo = _mm_loadh_pd(_mm_load_sd(base + idx[0]), base + idx[1]);

@@ -28,7 +28,7 @@ inline constexpr double kNever = std::numeric_limits<double>::infinity();
 ///  * f2 = 0: only if f1 < 0.
 /// f0 < 0 (invalid state) with f1 < 0 gives 0; with f2 < 0 and the parabola's top below zero, the time of the
 /// top (when the state starts to get worse again). Always inlined: it sits in the innermost loop of the event
-/// scans, and GCC stops inlining it once it has many callers (a call took 4 % more instructions).
+/// scans, and GCC stops inlining it once it has many callers (a call costs more than its body).
 [[gnu::always_inline]] inline double firstRootFalling(double f0, double f1, double f2) {
     if (f2 < 0) {
         const double arg = f1 * f1 - 2 * f2 * f0;

@@ -91,8 +91,8 @@ struct PotentialLaw {
 /// xi: the tangential spring [m], stored as a vector along t so that it changes sign with the pair's order.
 /// When the chord vanishes (one body inside the other) the normal falls back to the line of centres, and to +x
 /// when the centres coincide; the potential law's force then vanishes with |c| (a depth that max_overlap stops).
-/// Always inlined: as a call (its frame, register saves and the copies of its arguments) it cost the polygon force
-/// pass 3 % more instructions.
+/// Always inlined: as a call, its frame, register saves and the copies of its arguments cost the polygon force
+/// pass more instructions than the call saves.
 /// Law: OverlapAreaLaw or PotentialLaw (the normal force); kFriction: the tangential spring (TangentialLaw::Spring).
 template <class Law, bool kFriction>
 [[gnu::always_inline]] inline ContactForce polygonContact(const PolygonCoeffs& c, const Overlap& o, const BodyState& bi,

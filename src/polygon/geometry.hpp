@@ -333,7 +333,7 @@ inline bool twoCrossingOverlap(const V2* P, int np, const V2* Q, int nq, const V
 }
 
 /// Overlap of two convex polygons as clipOverlap computes it (pCentre and pShift required): twoCrossingOverlap
-/// where it applies, else the clipping. Out of line, like the clipping (inlining that into the force pass cost 1 %).
+/// where it applies, else the clipping. Out of line, like the clipping (inlined, it made the force pass slower).
 [[gnu::noinline]] inline Overlap convexOverlap(const V2* P, int np, const V2* Q, int nq, const V2& pCentre,
                                                double pRadius, const V2& pShift) {
     Overlap o;

@@ -272,8 +272,8 @@ template <int D, class Tangential>
         nl += testPair<D, Tangential>(in, bl, i, kernelVec(in.x[i]), in.radius[i], k, j, nl);
     };
     // The partners' rows that this pass and the law read, prefetched kAhead pairs ahead: the partners are not in
-    // address order, and on a core with a 1 MB L2 (AMD Zen 4) waiting for them took about a fifth of the step
-    // (bench/README.md, "Partners prefetched").
+    // address order, and on a core with a small L2 (AMD Zen 4, 1 MB) waiting for them is a large share of the
+    // step (bench/README.md, "Partners prefetched").
     constexpr std::uint32_t kAhead = 16;
     for (; 4 * g + 4 <= n; ++g) {
         const std::uint32_t k = k0 + 4 * g;
@@ -397,11 +397,8 @@ template <int D, class Normal, class Tangential, bool kCross, bool kLanes>
     std::uint32_t m = 0;
     // Eight pairs at a time, two groups of four side by side (Lanes2), then the last four. The law's chain of
     // square roots and divisions is long and about one group fits the processor's window, so two groups
-    // interleaved overlap their chains: the 2D chute's time per particle-step is ~6 % less (the minimum of 40
-    // windows, bench/tdm_chute.cpp, two runs of 6 and 8 alternating rounds: 0.938, 0.944). In 3D two groups'
-    // 3-vectors need more than AVX2's 16 registers, so only with AVX-512's 32: 1-2 % less on AMD Zen 4 (8 rounds
-    // twice: fastest windows 52.07 and 52.68 ns against 53.14 and 53.67); on the Intel Xeon measured before,
-    // 1.013.
+    // interleaved overlap their chains (faster in the fastest windows of bench/tdm_chute.cpp). In 3D two groups'
+    // 3-vectors need more than AVX2's 16 registers, so only with AVX-512's 32.
     constexpr bool kEight = kLanes && (D == 2 || kManyLaneRegisters);
     if constexpr (kEight) {
         for (; m + 8 <= nl; m += 8) {
