@@ -339,7 +339,7 @@ double EdmEngine<D>::keptTime(std::uint32_t s, double now) const {
             return sl_.wallTime(s, k, now);
         case kPair: {
             const Vec<D> d = sl_.posAt(sl_.hot[s], now) - sl_.posAt(sl_.hot[k], now);
-            Shift m{};
+            Shift m{};  // the image count itself (pairTime's shift), not the displacement minimumImage gives
             for (int a = 0; a < D; ++a)
                 if (w_.domain.periodic[a]) m[a] = -static_cast<std::int32_t>(std::nearbyint(d[a] / sl_.boxLen[a]));
             return sl_.pairTime(s, k, m, now, kNever);
