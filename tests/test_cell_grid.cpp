@@ -176,9 +176,26 @@ TEST(CellGrid, CoordinatesClampOrWrap) {
     EXPECT_EQ(g.wrappedCoord(Vec<2>{{0.0, 7.0}}, 1), 2);
     EXPECT_EQ(g.cellOf(Vec<2>{{1.2, 1.5}}), 2 + 4 * 1);  // x fastest
     EXPECT_EQ(g.stride(1), 4);
+    EXPECT_EQ(g.coord(2 + 4 * 1, 0), 2);  // a cell's coordinate along one axis
+    EXPECT_EQ(g.coord(2 + 4 * 1, 1), 1);
     const CellGrid<3> s = CellGrid<3>::spanning(Vec<3>::zero(), Vec<3>{{1.0, 2.5, 0.1}}, 0.3, {false, true, false});
     EXPECT_EQ(s.dims(), (std::array<int, 3>{3, 8, 1}));
     EXPECT_DOUBLE_EQ(s.width()[1], 2.5 / 8);
+    // A flat axis (zero length): one cell of width 0 by default, of width 1 with unitFlatAxes (the event grid's
+    // rule), whose cell of a point on it is 0.
+    const Vec<3> flatHi{{1.0, 2.5, 0.0}};
+    const CellGrid<3> f = CellGrid<3>::spanning(Vec<3>::zero(), flatHi, 0.3, {false, true, false}, true);
+    EXPECT_EQ(f.dims(), (std::array<int, 3>{3, 8, 1}));
+    EXPECT_EQ(CellGrid<3>::spanningDims(Vec<3>::zero(), flatHi, 0.3, true), f.dims());
+    EXPECT_EQ(f.width()[2], 1.0);
+    EXPECT_EQ(f.width()[1], s.width()[1]);
+    EXPECT_EQ(f.cellOf(Vec<3>{{0.5, 1.3, 0.0}}), 1 + 3 * 4);
+    EXPECT_EQ(CellGrid<3>::spanning(Vec<3>::zero(), flatHi, 0.3, {false, true, false}).width()[2], 0.0);
+    // The offset tables are padded to whole groups of eight with zeros.
+    EXPECT_EQ(CellGrid<3>::kStencilPad % 8, 0);
+    EXPECT_EQ(CellGrid<2>::kSidePad, 8);
+    EXPECT_EQ(f.offsets()[CellGrid<3>::kStencil], 0);
+    EXPECT_EQ(f.sideOffsets(2, true)[CellGrid<3>::kSide], 0);
     EXPECT_EQ(CellGrid<3>::mirror(CellGrid<3>::kCentre), CellGrid<3>::kCentre);
     EXPECT_EQ(CellGrid<2>::mirror(0), 8);
 }

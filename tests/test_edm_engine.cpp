@@ -591,7 +591,7 @@ TEST(EdmEngine, RejectsBadSettings) {
     s.cellSize = 0;
     EdmEngine<3> withShells(w, s);
     struct Silent final : EdmObserver<3> {
-        void restart(const EventCells<3>&) override {}
+        void restart(const CellGrid<3>&) override {}
         void joined(std::uint32_t, std::uint32_t, double) override {}
         void left(std::uint32_t, std::uint32_t, double) override {}
         void crossed(std::uint32_t, std::uint32_t, std::uint32_t, double) override {}

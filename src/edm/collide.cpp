@@ -79,9 +79,7 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     const bool fb = frozen(b);
     // The state at t, committed only if the collision happens (a skipped event leaves no trace).
     const Vec<D> va = sl_.velAt(sl_.hot[a], t), vb = sl_.velAt(sl_.hot[b], t);
-    Vec<D> d = sl_.posAt(sl_.hot[a], t) - sl_.posAt(sl_.hot[b], t);
-    for (int k = 0; k < D; ++k)
-        if (w_.domain.periodic[k]) d[k] += -std::nearbyint(d[k] / sl_.boxLen[k]) * sl_.boxLen[k];
+    const Vec<D> d = w_.domain.minimumImage(sl_.posAt(sl_.hot[a], t) - sl_.posAt(sl_.hot[b], t));
     const double bdot = dot(d, va - vb);
     const Vec<D> n = d * (1.0 / norm(d));
     // Rest hop (docs/edm.md): against a fixed obstacle that gravity pushes the particle into, the normal speed

@@ -191,10 +191,9 @@ void EdmEngine<D>::buildGrid() {
                                           "plus the neighbour shell"
                                         : "event-driven engine: cellSize is smaller than the largest diameter");
     if (!(edge > 0)) edge = 1;
-    // At most max(2^20, 8 N) cells: a huge open box with few particles gets larger cells. Below 2^28 - 1 in any
-    // case: Rec::cell has 28 bits and the free slots' cell is the one past the last.
-    const double maxCells = std::min(double((1u << Sl::kCellBits) - 2),
-                                     std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size())));
+    // At most max(2^20, 8 N) cells: a huge open box with few particles gets larger cells (the grid adds the cap of
+    // Rec::cell's bits).
+    const double maxCells = std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size()));
     grid_.build(w_.domain, edge, maxCells);
 }
 
@@ -340,7 +339,7 @@ double EdmEngine<D>::keptTime(std::uint32_t s, double now) const {
             return sl_.wallTime(s, k, now);
         case kPair: {
             const Vec<D> d = sl_.posAt(sl_.hot[s], now) - sl_.posAt(sl_.hot[k], now);
-            Shift m{};
+            Shift m{};  // the image count itself (pairTime's shift), not the displacement minimumImage gives
             for (int a = 0; a < D; ++a)
                 if (w_.domain.periodic[a]) m[a] = -static_cast<std::int32_t>(std::nearbyint(d[a] / sl_.boxLen[a]));
             return sl_.pairTime(s, k, m, now, kNever);

@@ -134,9 +134,9 @@ public:
     Vec<D> velocityAt(std::size_t i, double t) const { return sl_.velAt(sl_.hot[slotOf_[i]], t); }
 
     /// The event grid's geometry (what an EdmObserver is told).
-    const EventCells<D>& cells() const { return grid_.cells(); }
+    const CellGrid<D>& cells() const { return grid_.cells(); }
     std::uint32_t cellCount() const { return grid_.count(); }
-    const std::array<int, D>& cellDims() const { return grid_.cells().dims; }
+    const std::array<int, D>& cellDims() const { return grid_.cells().dims(); }
 
     /// Re-reads every particle from the World (after outside changes at world.time: positions, velocities,
     /// frozen flags, particles added or removed) and re-predicts all events. The engine keeps its own copy of

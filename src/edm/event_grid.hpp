@@ -5,8 +5,9 @@
 //   where(s)                     what a prediction of slot s needs of the grid (its cell's coordinates),
 //   exit(where, s, now, x, v)    s's next crossing of a cell face (an event of type kCell),
 //   forEachBatch(where, s, ...)  the candidate partners of s, four at a time, for the scan (edm/scan.hpp).
-// EventCells is the geometry alone (dimensions, cell of a point, neighbour cells with their periodic images),
-// which the engine also hands to an observer (edm/observer.hpp) so that a coupled engine can keep data per cell.
+// Its geometry is a CellGrid (neighbor/cell_grid.hpp), the one cell grid of the project, which the engine also hands
+// to an observer (edm/observer.hpp) so that a coupled engine can keep data per cell. What the event grid adds: a cap
+// on the number of cells (Rec::cell has kCellBits bits), and an axis of zero length as one cell of width 1.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -14,87 +15,10 @@
 #include "core/lanes_scan.hpp"
 #include "edm/scan.hpp"
 #include "edm/slots.hpp"
+#include "neighbor/cell_grid.hpp"
 #include "world/world.hpp"
 
 namespace haet {
-
-/// The geometry of the event-driven engine's cell grid. A cell's index is sum_k coord_k stride_k.
-template <int D>
-struct EventCells {
-    using Shift = std::array<std::int32_t, D>;
-    static constexpr int kNbrCells = D == 3 ? 27 : 9, kSideCells = D == 3 ? 9 : 3;
-    // The offset tables are padded with zeros to whole groups of eight (compactHeads reads eight at a time).
-    static constexpr int kNbrPad = (kNbrCells + 7) / 8 * 8, kSidePad = (kSideCells + 7) / 8 * 8;
-
-    std::array<int, D> dims{};  ///< cells per axis
-    std::array<std::uint32_t, D> stride{};
-    Vec<D> lo;     ///< lower corner of the box [m]
-    Vec<D> width;  ///< cell edges [m]
-    std::array<bool, D> periodic{};
-    std::array<std::int32_t, kNbrPad> deltaFull{};  ///< index offsets of the 3^D cells around one away from the faces
-    /// Index offsets of the 3^(D-1) new neighbours after a step along axis a in direction d: deltaSide[2 a + (d > 0)].
-    std::array<std::array<std::int32_t, kSidePad>, 2 * D> deltaSide{};
-
-    /// Cells of edge >= `edge` [m] over the domain's box, at most maxCells of them (the edge grows by 1.25 until
-    /// they fit).
-    static EventCells fit(const Domain<D>& dom, double edge, double maxCells);
-
-    std::uint32_t count() const {
-        std::uint32_t n = 1;
-        for (int k = 0; k < D; ++k) n *= static_cast<std::uint32_t>(dims[k]);
-        return n;
-    }
-    /// Coordinate of cell c on axis k.
-    int coord(std::uint32_t c, int k) const {
-        return static_cast<int>((c / stride[k]) % static_cast<std::uint32_t>(dims[k]));
-    }
-    /// The cell of point x (outside the box: the nearest outer cell).
-    std::uint32_t cellOf(const Vec<D>& x) const {
-        std::uint32_t c = 0;
-        for (int k = 0; k < D; ++k) {
-            int ck = static_cast<int>(std::floor((x[k] - lo[k]) / width[k]));
-            ck = std::clamp(ck, 0, dims[k] - 1);
-            c += static_cast<std::uint32_t>(ck) * stride[k];
-        }
-        return c;
-    }
-    /// Calls f(cell index, image) for cell c and its 3^D - 1 neighbours: periodic axes wrap (image: -1 or +1 box
-    /// lengths on the axes crossed), open ones end; on a periodic axis of fewer than 3 cells a cell can come twice.
-    template <class F>
-    void forEachAround(std::uint32_t c, F&& f) const {
-        std::array<int, D> cc;
-        bool interior = true;
-        for (int k = 0; k < D; ++k) {
-            cc[k] = coord(c, k);
-            interior = interior && cc[k] >= 1 && cc[k] <= dims[k] - 2;
-        }
-        if (interior) {
-            const Shift none{};
-            for (int q = 0; q < kNbrCells; ++q) f(c + static_cast<std::uint32_t>(deltaFull[q]), none);
-            return;
-        }
-        for (int code = 0; code < kNbrCells; ++code) {
-            std::uint32_t idx = 0;
-            Shift image{};
-            bool ok = true;
-            int q = code;
-            for (int k = 0; k < D; ++k) {
-                int ck = cc[k] + q % 3 - 1;
-                q /= 3;
-                if (ck < 0 || ck >= dims[k]) {
-                    if (!periodic[k]) {
-                        ok = false;
-                        break;
-                    }
-                    image[k] = ck < 0 ? -1 : 1;
-                    ck -= image[k] * dims[k];
-                }
-                idx += static_cast<std::uint32_t>(ck) * stride[k];
-            }
-            if (ok) f(idx, image);
-        }
-    }
-};
 
 namespace edm {
 
@@ -103,13 +27,17 @@ class EventGrid {
 public:
     using Sl = Slots<D>;
     using Shift = typename Sl::Shift;
-    static constexpr int kNbrCells = EventCells<D>::kNbrCells, kSideCells = EventCells<D>::kSideCells;
+    using Cells = CellGrid<D>;
+    static constexpr int kNbrCells = Cells::kStencil, kSideCells = Cells::kSide;
+    static_assert(Cells::kStencilPad % 8 == 0 && Cells::kSidePad % 8 == 0, "compactHeads loads eight offsets");
 
-    /// Cells of edge >= `edge` over the box, at most maxCells; every list empty.
+    /// Cells of edge >= `edge` [m] over the domain's box (CellGrid::spanning; an axis of zero length is one cell of
+    /// width 1), at most maxCells of them and fewer than 2^kCellBits - 1 (the edge grows by 1.25 until they fit);
+    /// every list empty.
     void build(const Domain<D>& dom, double edge, double maxCells);
-    const EventCells<D>& cells() const { return cells_; }
+    const Cells& cells() const { return cells_; }
     std::uint32_t count() const { return static_cast<std::uint32_t>(head_.size()); }
-    std::uint32_t cellOf(const Vec<D>& x) const { return cells_.cellOf(x); }
+    std::uint32_t cellOf(const Vec<D>& x) const { return static_cast<std::uint32_t>(cells_.cellOf(x)); }
     double smallestEdge() const;
     /// Whether a crossing may scan only the newly adjacent cells (7 cells or more on every periodic axis, so that
     /// the kept event's partner is at its minimum image: EdmEngine::keptTime).
@@ -136,10 +64,21 @@ public:
     void forEachIn(const Sl& sl, std::uint32_t c, F&& f) const {
         for (std::uint32_t j = head_[c]; j != kNil; j = sl.link[j].next) f(j);
     }
-    /// Calls f(slot, image) for every slot in the cells around c (EventCells::forEachAround).
+    /// Calls f(cell, image) for cell c and its 3^D - 1 neighbours (CellGrid::forEachNeighbour): periodic axes wrap,
+    /// open ones end; image: -1 or +1 box lengths on the axes crossed (-1 across a lower face).
+    template <class F>
+    void forEachCellAround(std::uint32_t c, F&& f) const {
+        cells_.forEachNeighbour(static_cast<int>(c), [&](int cell, int image) {
+            const std::array<int, D> o = Cells::offsetsOf(image);
+            Shift sh;
+            for (int k = 0; k < D; ++k) sh[k] = o[k];
+            f(static_cast<std::uint32_t>(cell), static_cast<const Shift&>(sh));
+        });
+    }
+    /// Calls f(slot, image) for every slot in the cells around c (forEachCellAround).
     template <class F>
     void forEachAround(const Sl& sl, std::uint32_t c, F&& f) const {
-        cells_.forEachAround(c, [&](std::uint32_t cell, const Shift& image) {
+        forEachCellAround(c, [&](std::uint32_t cell, const Shift& image) {
             for (std::uint32_t j = head_[cell]; j != kNil; j = sl.link[j].next) f(j, image);
         });
     }
@@ -151,12 +90,8 @@ public:
     };
     Where where(const Sl& sl, std::uint32_t s) const {
         Where at;
-        at.interior = true;
-        for (int k = 0; k < D; ++k) {
-            const int c = cells_.coord(sl.rec[s].cell, k);
-            at.cc[k] = c;
-            at.interior = at.interior && c >= 1 && c <= cells_.dims[k] - 2;
-        }
+        at.cc = cells_.coords(static_cast<int>(sl.rec[s].cell));
+        at.interior = cells_.interior(at.cc);
         return at;
     }
     /// The next crossing of a face of s's cell, from its box-frame state now (x, v). From the older stored state
@@ -166,9 +101,10 @@ public:
         Candidate cross;
         for (int k = 0; k < D; ++k) {
             const int c = at.cc[k];
-            const bool per = cells_.periodic[k];
-            const double lo = (c == 0 && !per) ? -kNever : cells_.lo[k] + c * cells_.width[k];
-            const double hi = (c == cells_.dims[k] - 1 && !per) ? kNever : cells_.lo[k] + (c + 1) * cells_.width[k];
+            const bool per = cells_.periodic(k);
+            const double lo = (c == 0 && !per) ? -kNever : cells_.origin()[k] + c * cells_.width()[k];
+            const double hi =
+                (c == cells_.dim(k) - 1 && !per) ? kNever : cells_.origin()[k] + (c + 1) * cells_.width()[k];
             const CellExit ex = cellExitTime(x[k] - ws[k] * sl.boxLen[k], v[k], sl.g[k], lo, hi);
             if (ex.time < kNever) {
                 const double t = now + ex.time;
@@ -190,7 +126,7 @@ public:
                                                     int axis, int dir, F&& four) const;
 
 private:
-    EventCells<D> cells_;
+    Cells cells_;
     std::vector<std::uint32_t> head_;
     bool partialScans_ = true;
 };
@@ -198,16 +134,16 @@ private:
 template <int D>
 inline std::uint32_t EventGrid<D>::cross(Sl& sl, std::uint32_t s, int axis, bool up) {
     const std::uint32_t oldCell = sl.rec[s].cell;
-    const int c = cells_.coord(oldCell, axis);
+    const int n = cells_.dim(axis), c = cells_.coord(static_cast<int>(oldCell), axis);
     int cn = c + (up ? 1 : -1);
-    if (cn >= cells_.dims[axis] || cn < 0) {  // only on periodic axes: outer cells of open axes are unbounded
-        cn = cn < 0 ? cells_.dims[axis] - 1 : 0;
+    if (cn >= n || cn < 0) {  // only on periodic axes: outer cells of open axes are unbounded
+        cn = cn < 0 ? n - 1 : 0;
         Shift ws = Sl::wrapsOf(sl.link[s].wrap);
         ws[axis] += up ? 1 : -1;
         sl.setWraps(s, ws);
     }
-    const std::uint32_t newCell =
-        oldCell + (static_cast<std::uint32_t>(cn) - static_cast<std::uint32_t>(c)) * cells_.stride[axis];
+    const std::uint32_t newCell = oldCell + (static_cast<std::uint32_t>(cn) - static_cast<std::uint32_t>(c)) *
+                                                static_cast<std::uint32_t>(cells_.stride(axis));
     remove(sl, s);
     insert(sl, s, newCell);
     return oldCell;
@@ -237,25 +173,26 @@ template <class F>
     for (int k = 0; k < D; ++k) negWs[k] = -ws[k];
     if (at.interior) {
         const std::uint32_t* hc = &head_[sl.rec[s].cell];
-        nc = axis < 0 ? compactHeads<kNbrCells>(hc, cells_.deltaFull.data(), heads)
-                      : compactHeads<kSideCells>(hc, cells_.deltaSide[2 * axis + (dir > 0 ? 1 : 0)].data(), heads);
+        nc = axis < 0 ? compactHeads<kNbrCells>(hc, cells_.offsets(), heads)
+                      : compactHeads<kSideCells>(hc, cells_.sideOffsets(axis, dir > 0), heads);
     } else {
         std::array<std::array<int, 3>, D> nbr, omega;
         std::array<int, D> nbrCount;
         bool any = true;
         for (int k = 0; k < D; ++k) {
-            const bool per = cells_.periodic[k];
+            const bool per = cells_.periodic(k);
+            const int dk = cells_.dim(k);
             int m = 0;
             for (int o = -1; o <= 1; ++o) {
                 if (k == axis && o != dir) continue;
                 int cn = at.cc[k] + o, om = 0;
                 if (cn < 0) {
                     if (!per) continue;
-                    cn += cells_.dims[k];
+                    cn += dk;
                     om = -1;
-                } else if (cn >= cells_.dims[k]) {
+                } else if (cn >= dk) {
                     if (!per) continue;
-                    cn -= cells_.dims[k];
+                    cn -= dk;
                     om = 1;
                 }
                 nbr[k][m] = cn;
@@ -270,7 +207,7 @@ template <class F>
             std::uint32_t cellIndex = 0;
             bool plain = true;
             for (int k = 0; k < D; ++k) {
-                cellIndex += static_cast<std::uint32_t>(nbr[k][it[k]]) * cells_.stride[k];
+                cellIndex += static_cast<std::uint32_t>(nbr[k][it[k]] * cells_.stride(k));
                 bases[nc][k] = -ws[k] - omega[k][it[k]];
                 plain = plain && omega[k][it[k]] == 0;
             }

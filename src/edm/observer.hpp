@@ -10,7 +10,7 @@
 // without an observer (a pure event-driven run) a call site costs one test of the pointer.
 #include <cstdint>
 
-#include "edm/event_grid.hpp"
+#include "neighbor/cell_grid.hpp"
 
 namespace haet {
 
@@ -20,7 +20,7 @@ public:
     virtual ~EdmObserver() = default;
     /// The engine (re)starts: the geometry of the cells it reports in; every particle it owns is reported afresh
     /// (joined) right after, in the engine's order.
-    virtual void restart(const EventCells<D>& cells) = 0;
+    virtual void restart(const CellGrid<D>& cells) = 0;
     /// World particle i (radius r [m]) joined the engine, in cell `cell`.
     virtual void joined(std::uint32_t i, std::uint32_t cell, double r) = 0;
     /// World particle i (radius r [m]) left the engine; it was in cell `cell`.

@@ -37,7 +37,7 @@ typename Reference<D>::Event Reference<D>::next(double now) const {
         for (std::uint32_t j = 0; j < n; ++j) {
             if (j == s) continue;
             const Vec<D> d = xs - sl_.posAt(sl_.hot[j], now);
-            Shift m{};
+            Shift m{};  // the image count itself (pairTime's shift), not the displacement minimumImage gives
             for (int k = 0; k < D; ++k)
                 if (dom.periodic[k]) m[k] = -static_cast<std::int32_t>(std::nearbyint(d[k] / sl_.boxLen[k]));
             const double tp = sl_.pairTime(s, j, m, now, c.time);

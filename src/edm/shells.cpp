@@ -56,7 +56,7 @@ bool Shells<D>::meet(const Sl& sl, std::uint32_t s, std::uint32_t j, const Shift
 template <int D>
 bool Shells<D>::link(const Sl& sl, const EventGrid<D>& grid, std::uint32_t s) {
     bool ok = true;
-    grid.cells().forEachAround(sl.rec[s].cell, [&](std::uint32_t c, const Shift& image) {
+    grid.forEachCellAround(sl.rec[s].cell, [&](std::uint32_t c, const Shift& image) {
         if (!ok) return;
         grid.forEachIn(sl, c, [&](std::uint32_t j) {
             if (!ok || j == s || !meet(sl, s, j, image)) return;

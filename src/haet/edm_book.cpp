@@ -8,14 +8,14 @@
 namespace haet {
 
 template <int D>
-void EdmBook<D>::restart(const EventCells<D>& cells) {
+void EdmBook<D>::restart(const CellGrid<D>& cells) {
     cells_ = cells;
     for (int k = 0; k < D; ++k) {
-        const int nc = cells_.dims[k], nz = zones_.dims()[k];
+        const int nc = cells_.dim(k), nz = zones_.dims()[k];
         zoneCoord_[k].resize(nc);
         zoneCellBegin_[k].assign(nz + 1, static_cast<std::uint32_t>(nc));
         for (int c = nc; c-- > 0;) {
-            const double xc = (c + 0.5) * cells_.width[k];
+            const double xc = (c + 0.5) * cells_.width()[k];
             const int z = std::clamp(static_cast<int>(std::floor(xc / zones_.zoneWidth()[k])), 0, nz - 1);
             zoneCoord_[k][c] = static_cast<std::uint32_t>(z);
             zoneCellBegin_[k][z] = static_cast<std::uint32_t>(c);
@@ -24,16 +24,16 @@ void EdmBook<D>::restart(const EventCells<D>& cells) {
         for (int z = nz; z-- > 0;) zoneCellBegin_[k][z] = std::min(zoneCellBegin_[k][z], zoneCellBegin_[k][z + 1]);
     }
     volume_.assign(static_cast<std::size_t>(zones_.count()), 0.0);
-    head_.assign(cells_.count(), kNone);
+    head_.assign(static_cast<std::size_t>(cells_.count()), kNone);
     std::fill(cell_.begin(), cell_.end(), kNone);
 }
 
 template <int D>
 std::uint32_t EdmBook<D>::zoneOfCell(std::uint32_t c) const {
+    const std::array<int, D> cc = cells_.coords(static_cast<int>(c));
     std::uint32_t z = 0;
     for (int k = 0; k < D; ++k)
-        z += zoneCoord_[k][static_cast<std::uint32_t>(cells_.coord(c, k))] *
-             static_cast<std::uint32_t>(zones_.stride(k));
+        z += zoneCoord_[k][static_cast<std::uint32_t>(cc[k])] * static_cast<std::uint32_t>(zones_.stride(k));
     return z;
 }
 

@@ -21,14 +21,14 @@ public:
     /// event-driven particle is watched (owned by the hybrid, sized cells().count() before the first crossing).
     EdmBook(const ZoneGrid<D>& zones, const std::vector<std::uint8_t>& guard) : zones_(zones), guard_(guard) {}
 
-    void restart(const EventCells<D>& cells) override;
+    void restart(const CellGrid<D>& cells) override;
     void joined(std::uint32_t i, std::uint32_t cell, double r) override;
     void left(std::uint32_t i, std::uint32_t cell, double r) override;
     void crossed(std::uint32_t i, std::uint32_t from, std::uint32_t to, double r) override;
     void tcCollision(std::uint32_t i) override { tcHandovers_.push_back(i); }
 
     /// The event grid's geometry.
-    const EventCells<D>& cells() const { return cells_; }
+    const CellGrid<D>& cells() const { return cells_; }
     /// Per axis and zone coordinate z: the first cell coordinate whose centre is in zone z (entry z + 1 ends it).
     const std::array<std::vector<std::uint32_t>, D>& zoneCellBegin() const { return zoneCellBegin_; }
     /// The cell of event-driven World particle i.
@@ -59,7 +59,7 @@ private:
 
     const ZoneGrid<D>& zones_;
     const std::vector<std::uint8_t>& guard_;
-    EventCells<D> cells_;
+    CellGrid<D> cells_;
     std::array<std::vector<std::uint32_t>, D> zoneCoord_;  // per axis and cell coordinate: zone coordinate
     std::array<std::vector<std::uint32_t>, D> zoneCellBegin_;
     std::vector<double> volume_;

@@ -149,7 +149,7 @@ void HaetEngine<D>::synchronise() {
 
 template <int D>
 void HaetEngine<D>::bin(const Vec<D>& x, double r) {
-    const std::uint32_t c = book_.cells().cellOf(x);
+    const auto c = static_cast<std::uint32_t>(book_.cells().cellOf(x));
     if (binHead_[c] == kNil) binCells_.push_back(c);
     const auto b = static_cast<std::uint32_t>(bins_.size());
     bins_.push_back(Binned{x, r, binHead_[c], kNil});
@@ -163,7 +163,8 @@ void HaetEngine<D>::bin(const Vec<D>& x, double r) {
 
 template <int D>
 void HaetEngine<D>::markAround(std::uint32_t cell, std::uint8_t level) {
-    book_.cells().forEachAround(cell, [&](std::uint32_t idx, const auto&) {
+    book_.cells().forEachNeighbour(static_cast<int>(cell), [&](int nb, int) {
+        const auto idx = static_cast<std::uint32_t>(nb);
         std::uint8_t& g = guard_[idx];
         const std::uint8_t oldLevel = g & 3, newLevel = g >> 2;
         if (newLevel >= level) return;
@@ -372,7 +373,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
             at[k] = lo[k];
         }
         if (empty) continue;
-        const std::array<int, D>& nc = book_.cells().dims;
+        const std::array<int, D>& nc = book_.cells().dims();
         for (;;) {
             std::uint32_t idx = 0, stride = 1;
             for (int k = 0; k < D; ++k) {
@@ -399,7 +400,8 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
     // candidates of the cells around it back on the work list.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> byCell;  // (cell, candidate), sorted
     byCell.reserve(candidates.size());
-    for (const std::uint32_t i : candidates) byCell.emplace_back(book_.cells().cellOf(p.x[i]), i);
+    for (const std::uint32_t i : candidates)
+        byCell.emplace_back(static_cast<std::uint32_t>(book_.cells().cellOf(p.x[i])), i);
     std::sort(byCell.begin(), byCell.end());
     std::vector<std::uint8_t> stays(byCell.size(), 0);
     std::vector<std::size_t> work(byCell.size());
@@ -414,7 +416,8 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
         const bool fresh = binHead_[c] == kNil;
         bin(p.x[i], p.radius[i]);
         if (fresh) markAround(c, 1);
-        book_.cells().forEachAround(c, [&](std::uint32_t idx, const auto&) {
+        book_.cells().forEachNeighbour(static_cast<int>(c), [&](int cell, int) {
+            const auto idx = static_cast<std::uint32_t>(cell);
             auto at = std::lower_bound(byCell.begin(), byCell.end(), std::make_pair(idx, std::uint32_t{0}));
             for (; at != byCell.end() && at->first == idx; ++at) {
                 const std::size_t r = static_cast<std::size_t>(at - byCell.begin());
@@ -504,7 +507,8 @@ void HaetEngine<D>::convert(std::vector<std::uint32_t> arrivals, std::vector<std
     for (std::size_t k = 0; k < nT; ++k) {
         if (from[k] != TdmEngine<D>::kFresh) continue;
         bin(p.x[k], p.radius[k]);
-        book_.cells().forEachAround(book_.cells().cellOf(p.x[k]), [&](std::uint32_t idx, const auto&) {
+        book_.cells().forEachNeighbour(book_.cells().cellOf(p.x[k]), [&](int nb, int) {
+            const auto idx = static_cast<std::uint32_t>(nb);
             if (guard_[idx] != 0) return;
             guard_[idx] = 1;
             guardList_.push_back(idx);

@@ -51,16 +51,28 @@ public:
         }
     }
     /// Cells no narrower than `edge` [m] spanning [lo, hi] exactly: floor(L / edge) cells (at least one) of width
-    /// L / n along each axis, so a point's neighbours within `edge` lie in the 3^D cells around its own.
-    static CellGrid spanning(const Vec<D>& lo, const Vec<D>& hi, double edge, const std::array<bool, D>& periodic) {
-        std::array<int, D> n;
+    /// L / n along each axis, so a point's neighbours within `edge` lie in the 3^D cells around its own. With
+    /// unitFlatAxes an axis of zero length (a flat box) is one cell of width 1 [m] instead of width 0, so that the
+    /// cell of a point on it is a finite quotient, 0, rather than 0 / 0.
+    static CellGrid spanning(const Vec<D>& lo, const Vec<D>& hi, double edge, const std::array<bool, D>& periodic,
+                             bool unitFlatAxes = false) {
+        const std::array<int, D> n = spanningDims(lo, hi, edge, unitFlatAxes);
         Vec<D> width;
         for (int k = 0; k < D; ++k) {
             const double L = hi[k] - lo[k];
-            n[k] = std::max(1, static_cast<int>(std::floor(L / edge)));
-            width[k] = L / n[k];
+            width[k] = unitFlatAxes && !(L > 0) ? 1.0 : L / n[k];
         }
         return CellGrid(lo, n, width, periodic);
+    }
+    /// The cells per axis of spanning(lo, hi, edge, ., unitFlatAxes), without building the grid (a caller that caps
+    /// the number of cells tries edges whose product of cells may not fit in an int).
+    static std::array<int, D> spanningDims(const Vec<D>& lo, const Vec<D>& hi, double edge, bool unitFlatAxes = false) {
+        std::array<int, D> n;
+        for (int k = 0; k < D; ++k) {
+            const double L = hi[k] - lo[k];
+            n[k] = unitFlatAxes && !(L > 0) ? 1 : std::max(1, static_cast<int>(std::floor(L / edge)));
+        }
+        return n;
     }
 
     int dim(int k) const { return n_[k]; }
@@ -106,18 +118,27 @@ public:
     }
     int cellOf(const Vec<D>& x) const { return index(coordsOf(x)); }
     int wrappedCellOf(const Vec<D>& x) const { return index(wrappedCoordsOf(x)); }
+    /// The coordinates of cell index `cell` in [0, count()).
     std::array<int, D> coords(int cell) const {
         std::array<int, D> c;
-        for (int k = 0; k < D; ++k) {  // index() is x fastest
+        for (int k = 0; k < D - 1; ++k) {  // index() is x fastest
             c[k] = cell % n_[k];
             cell /= n_[k];
         }
+        c[D - 1] = cell;  // what is left is below n[D-1] for a cell of the grid: no division needed
         return c;
+    }
+    /// Coordinate of a cell along axis k alone (coords(cell)[k] without the other axes' divisions).
+    int coord(int cell, int k) const {
+        return static_cast<int>(static_cast<unsigned>(cell) / static_cast<unsigned>(stride_[k]) %
+                                static_cast<unsigned>(n_[k]));
     }
     /// No face of the grid within one cell: the 3^D cells around are cell + offsets()[q], none through an image.
     bool interior(const std::array<int, D>& c) const {
+        // 1 <= c <= n - 2 as one unsigned comparison, c - 1 < n - 2 (false for every c when n <= 2), and the axes
+        // combined without branches: a prediction of the event-driven engine asks this of every particle.
         bool in = true;
-        for (int k = 0; k < D; ++k) in = in && c[k] >= 1 && c[k] <= n_[k] - 2;
+        for (int k = 0; k < D; ++k) in &= static_cast<unsigned>(c[k] - 1) < static_cast<unsigned>(n_[k] - 2);
         return in;
     }
 
