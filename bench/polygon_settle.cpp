@@ -23,41 +23,8 @@ constexpr double kA = 0.002;  // lattice constant [m]
 constexpr int kRows = 100, kCols = 100;
 
 haet::Scenario scene() {
-    // 100.5 a wide (alternate rows shift by a/2), rows sqrt(3)/2 a apart.
-    return haet::parseScenario(R"(name = "bench_settle"
-dimension = 2
-duration = 1.0
-seed = 9
-[domain]
-lo = [0.0, 0.0]
-hi = [0.201, 0.25]
-gravity = [0.0, -9.81]
-[materials.grain]
-density = 2.0
-young = 1000.0
-restitution = 0.8
-friction = 0.5
-[contact]
-normal = "linear"
-duration = 3e-4
-tangential = "spring"
-[tdm]
-integrator = "gear5"
-dt = 1.5e-5
-[[walls]]
-point = [0.0, 0.0]
-normal = [0.0, 1.0]
-material = "grain"
-[[walls]]
-point = [0.0, 0.0]
-normal = [1.0, 0.0]
-material = "grain"
-[[walls]]
-point = [0.201, 0.0]
-normal = [-1.0, 0.0]
-material = "grain"
-)",
-                               "bench_settle.toml");
+    // 100.5 a wide (alternate rows shift by a/2), rows sqrt(3)/2 a apart: examples/hexagon_bed2d.toml.
+    return haet::loadScenario(std::string(HAET_SOURCE_DIR) + "/examples/hexagon_bed2d.toml");
 }
 
 haet::World<2> packing(const haet::Scenario& sc, bool polygons) {
