@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 namespace haet::testing {
@@ -21,6 +23,15 @@ inline std::string replaced(std::string text, const std::string& from, const std
     EXPECT_NE(at, std::string::npos) << from;
     if (at != std::string::npos) text.replace(at, from.size(), to);
     return text;
+}
+
+/// The text of the scene examples/NAME (tests run the scenes users have, or variants edited from them).
+inline std::string sceneText(const std::string& name) {
+    std::ifstream in(std::string(HAET_SOURCE_DIR) + "/examples/" + name);
+    EXPECT_TRUE(in.good()) << "examples/" << name;
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
 }
 
 }  // namespace haet::testing

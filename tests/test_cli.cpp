@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "scenario_text.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -90,42 +92,8 @@ protected:
     fs::path dir_;
 };
 
-// A tiny valid scenario: 8 spheres on a lattice drop onto a floor. dt = t_c / 50 = 2e-6 s, 500 steps.
-const std::string kTiny = R"(name = "tiny"
-dimension = 3
-duration = 0.001
-seed = 1
-
-[domain]
-lo = [0, 0, 0]
-hi = [0.01, 0.01, 0.01]
-gravity = [0, 0, -9.81]
-
-[materials.glass]
-density = 2500
-restitution = 0.8
-friction = 0.5
-
-[contact]
-normal = "linear"
-duration = 1e-4
-tangential = "spring"
-
-[[walls]]
-point = [0, 0, 0]
-normal = [0, 0, 1]
-material = "glass"
-
-[[insert]]
-arrangement = "lattice"
-count = 8
-radius = 0.001
-material = "glass"
-
-[output]
-series_period = 1e-4
-snapshot_period = 5e-4
-)";
+// A tiny valid scenario: 8 spheres on a lattice drop onto a floor (examples/drop3d_tiny.toml).
+const std::string kTiny = haet::testing::sceneText("drop3d_tiny.toml");
 
 /// kTiny with the first line that starts with `from` replaced by `to` (which may hold several lines).
 std::string edit(const std::string& from, const std::string& to) {

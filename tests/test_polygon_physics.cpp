@@ -340,47 +340,7 @@ TEST(PolygonRepose, PolygonHeapIsSteeperThanDiskHeap) {
 // Thread-count independence of the polygon loop (its two-pass path runs from 2048 particles on)
 // ------------------------------------------------------------------------------------------------------------
 TEST(PolygonThreads, BitIdenticalWithOneAndTwoThreads) {
-    const Scenario sc = parseScenario(R"(name = "threads_poly"
-dimension = 2
-duration = 1.0
-seed = 4
-[domain]
-lo = [0.0, 0.0]
-hi = [0.2, 0.1]
-periodic = [true, false]
-gravity = [0.0, -9.81]
-[materials.grain]
-density = 2.0
-young = 1000.0
-restitution = 0.8
-friction = 0.5
-[contact]
-normal = "linear"
-duration = 3e-4
-tangential = "spring"
-[[walls]]
-point = [0.0, 0.0]
-normal = [0.0, 1.0]
-material = "grain"
-[[insert]]
-arrangement = "lattice"
-shape = "polygon"
-polygon = "random"
-sides = [3, 8]
-orientation = "random"
-count = 2000
-radius = 0.001
-material = "grain"
-region = { lo = [0.0, 0.0], hi = [0.2, 0.1] }
-temperature = 0.01
-[[insert]]
-arrangement = "random"
-count = 200
-radius = 0.0008
-material = "grain"
-region = { lo = [0.0, 0.0], hi = [0.2, 0.1] }
-)",
-                                      "threads_poly.toml");
+    const Scenario sc = loadScenario(std::string(HAET_SOURCE_DIR) + "/examples/polygon_threads2d.toml");
     auto run = [&](int threads) {
         omp_set_num_threads(threads);
         World<2> w = buildWorld<2>(sc);

@@ -25,53 +25,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Hexagons on a lattice and random polygons above them, no disks: the linear law needs no duration.
-const std::string kPolygons = R"(name = "poly"
-dimension = 2
-duration = 0.002
-seed = 3
-
-[domain]
-lo = [0, 0]
-hi = [0.05, 0.05]
-gravity = [0, -9.81]
-
-[materials.grain]
-density = 2.0
-young = 2000
-restitution = 0.9
-friction = 0.5
-
-[[walls]]
-point = [0, 0]
-normal = [0, 1]
-material = "grain"
-
-[[insert]]
-arrangement = "lattice"
-shape = "polygon"
-sides = 6
-orientation = 0.25
-count = 40
-radius = 0.002
-material = "grain"
-region = { lo = [0, 0], hi = [0.05, 0.02] }
-
-[[insert]]
-arrangement = "random"
-shape = "polygon"
-polygon = "random"
-sides = [4, 9]
-aspect = 1.8
-orientation = "random"
-count = 30
-radius = [0.0015, 0.002]
-material = "grain"
-region = { lo = [0, 0.02], hi = [0.05, 0.05] }
-
-[output]
-snapshot_period = 0.001
-)";
+// Hexagons on a lattice and random polygons above them, no disks: the linear law needs no duration
+// (examples/polygon_mix2d.toml).
+const std::string kPolygons = testing::sceneText("polygon_mix2d.toml");
 
 using haet::testing::lineOf;
 using haet::testing::replaced;
