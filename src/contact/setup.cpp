@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <mutex>
 
 namespace haet {
 namespace {
@@ -24,17 +26,17 @@ double normalForce(NormalLaw law, HertzDamping damping, const PairCoeffs& c, dou
     return c.hertzK * std::sqrt(reff) * delta * std::sqrt(delta);
 }
 
-/// Finds the damping coefficient x >= 0 of a Hertz law for which a head-on collision at speed v gives
+/// Finds the damping coefficient x >= 0 of a law for which a head-on collision at speed v gives
 /// restitution e, with the contact-ending rule in force (bisection: e falls as x grows). `set` stores x in the
 /// coefficients; `scale` is a first guess of its size.
 template <class Set>
-double solveHertzDamping(const PairCoeffs& base, HertzDamping law, Set set, double scale, double e, double meff,
-                         double reff, double v, bool attraction) {
+double solveDamping(NormalLaw normal, const PairCoeffs& base, HertzDamping law, Set set, double scale, double e,
+                    double meff, double reff, double v, bool attraction) {
     if (e >= 1) return 0;
     PairCoeffs c = base;
     auto restitutionAt = [&](double x) {
         set(c, x);
-        return simulateHeadOn(NormalLaw::Hertz, law, c, meff, reff, v, attraction).restitution;
+        return simulateHeadOn(normal, law, c, meff, reff, v, attraction).restitution;
     };
     double lo = 0, hi = scale;
     while (restitutionAt(hi) >= e) {
@@ -103,6 +105,27 @@ struct PairRef {
     double meffRef = 0, reffRef = 0;  ///< [kg], [m]
 };
 
+/// gamma_n t_c of the linear law from (e, t_c) when the normal force is clipped at zero (attraction = false). The
+/// analytic gamma_n = -2 ln(e) / t_c assumes the contact lasts until the overlap returns to zero; with the clipped
+/// force the particles separate earlier, while the spring still pushes, and e comes out larger (0.632 for 0.6).
+/// So the damping is solved for, by the head-on integration with the clipping rule, so that e is the one asked
+/// for. With k_n = (pi^2 + ln^2 e) / t_c^2 per unit effective mass the collision scales with t_c and does not
+/// depend on the masses, so gamma_n t_c depends on e alone: solved once per e (in units t_c = 1, m_eff = 1).
+double linearClippedDamping(double e) {
+    static std::mutex guard;
+    static std::map<double, double> solved;
+    const std::lock_guard<std::mutex> lock(guard);
+    if (const auto it = solved.find(e); it != solved.end()) return it->second;
+    const double lne = std::log(e);
+    PairCoeffs c;
+    c.knPerMeff = kPi * kPi + lne * lne;
+    const double x = solveDamping(
+        NormalLaw::Linear, c, HertzDamping::None, [](PairCoeffs& pc, double g) { pc.gnPerMeff = g; },
+        std::max(-2 * lne, 1e-3), e, 1.0, 1.0, 1.0, false);
+    solved.emplace(e, x);
+    return x;
+}
+
 /// Linear spring-dashpot (docs/physics.md B.2) from a fixed k_n (and gamma_n), or from (e, t_c).
 void setUpLinear(PairCoeffs& c, const ContactModelDef& cd, const PairRef& p) {
     if (cd.kn) {
@@ -116,7 +139,7 @@ void setUpLinear(PairCoeffs& c, const ContactModelDef& cd, const PairRef& p) {
     } else if (cd.duration) {
         const double tc = *cd.duration;
         c.knPerMeff = (kPi * kPi + p.lne * p.lne) / (tc * tc);
-        c.gnPerMeff = -2 * p.lne / tc;
+        c.gnPerMeff = (cd.attraction ? -2 * p.lne : linearClippedDamping(p.e)) / tc;
     }
 }
 
@@ -145,20 +168,22 @@ void setUpHertz(PairCoeffs& c, const ContactModelDef& cd, const PairRef& p) {
         // Tsuji's alpha(e) fit assumes the contact ends at zero overlap; with the force clipped at zero the same
         // alpha gives a larger e. Solve for the alpha that gives e under the rule in force, starting from the fit
         // (the collision is speed-independent for this law).
-        c.tsujiAlpha = cd.attraction ? tsujiAlpha(p.e)
-                                     : solveHertzDamping(
-                                           c, HertzDamping::Tsuji, [](PairCoeffs& pc, double x) { pc.tsujiAlpha = x; },
-                                           std::max(tsujiAlpha(p.e), 1e-3), p.e, p.meffRef, p.reffRef,
-                                           cd.impactVelocity, cd.attraction);
+        c.tsujiAlpha =
+            cd.attraction
+                ? tsujiAlpha(p.e)
+                : solveDamping(
+                      NormalLaw::Hertz, c, HertzDamping::Tsuji, [](PairCoeffs& pc, double x) { pc.tsujiAlpha = x; },
+                      std::max(tsujiAlpha(p.e), 1e-3), p.e, p.meffRef, p.reffRef, cd.impactVelocity, cd.attraction);
     } else if (cd.hertzDamping == HertzDamping::Viscoelastic) {
         if (p.a.dissipationTime && p.b.dissipationTime) {
             c.dissipationTime = 0.5 * (*p.a.dissipationTime + *p.b.dissipationTime);
         } else {
             // The elastic contact time bounds any sensible A*.
             const double tcRef = hertzContactTime(c, p.meffRef, p.reffRef, cd.impactVelocity);
-            c.dissipationTime = solveHertzDamping(
-                c, HertzDamping::Viscoelastic, [](PairCoeffs& pc, double x) { pc.dissipationTime = x; }, tcRef, p.e,
-                p.meffRef, p.reffRef, cd.impactVelocity, cd.attraction);
+            c.dissipationTime = solveDamping(
+                NormalLaw::Hertz, c, HertzDamping::Viscoelastic,
+                [](PairCoeffs& pc, double x) { pc.dissipationTime = x; }, tcRef, p.e, p.meffRef, p.reffRef,
+                cd.impactVelocity, cd.attraction);
         }
     }
 }
@@ -261,9 +286,13 @@ ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<Mate
     const double meffMin = 0.5 * all.minMass;
     const double reffMin = 0.5 * all.minRadius;
     double tc = std::numeric_limits<double>::infinity();
+    // The linear law from (e, t_c) with the force clipped: its damping is solved for (linearClippedDamping), so
+    // its damped period is no longer t_c; the time-step rule keeps the t_c the user gave.
+    const bool givenDuration = cd.normal == NormalLaw::Linear && !cd.kn && cd.duration && !cd.attraction;
     for (const PairCoeffs& c : s.table)
-        tc = std::min(tc, cd.normal == NormalLaw::Linear ? linearContactTime(c, meffMin)
-                                                         : hertzContactTime(c, meffMin, reffMin, cd.impactVelocity));
+        tc = std::min(tc, givenDuration                    ? *cd.duration
+                          : cd.normal == NormalLaw::Linear ? linearContactTime(c, meffMin)
+                                                           : hertzContactTime(c, meffMin, reffMin, cd.impactVelocity));
     s.contactTime = tc;
     s.diskContactTime = tc;
     if (cd.normal == NormalLaw::Linear)
