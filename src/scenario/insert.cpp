@@ -22,13 +22,6 @@ namespace {
 
 std::string insertKey(std::size_t k) { return "insert[" + std::to_string(k + 1) + "]"; }
 
-std::string_view trim(std::string_view s) {
-    const auto first = s.find_first_not_of(" \t\r\n");
-    if (first == std::string_view::npos) return {};
-    const auto last = s.find_last_not_of(" \t\r\n");
-    return s.substr(first, last - first + 1);
-}
-
 std::vector<std::string_view> splitOn(std::string_view s, char sep) {
     std::vector<std::string_view> out;
     std::size_t start = 0;

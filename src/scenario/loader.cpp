@@ -704,13 +704,6 @@ private:
 // same code as a value of the file and its errors name the key the same way. Its value keeps the TOML source name
 // "--set KEY=VALUE", which is how TableReader::posOfNode tells it from the file's values.
 
-std::string trimmed(std::string_view s) {
-    const auto isSpace = [](char c) { return c == ' ' || c == '\t'; };
-    while (!s.empty() && isSpace(s.front())) s.remove_prefix(1);
-    while (!s.empty() && isSpace(s.back())) s.remove_suffix(1);
-    return std::string(s);
-}
-
 bool isBareKeyChar(char c) {
     return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
 }
@@ -754,8 +747,8 @@ std::string applyOverride(toml::table& root, const std::string& text, const std:
     const SourcePos pos{file + " (" + source + ")", 0};
     const std::size_t eq = text.find('=');
     if (eq == std::string::npos) throw ScenarioError(pos, "", "expected KEY=VALUE");
-    const std::string key = trimmed(std::string_view(text).substr(0, eq));
-    const std::string value = trimmed(std::string_view(text).substr(eq + 1));
+    const std::string key(trim(std::string_view(text).substr(0, eq)));
+    const std::string value(trim(std::string_view(text).substr(eq + 1)));
     const auto steps = parseKeyPath(key);
     if (!steps)
         throw ScenarioError(pos, key,
