@@ -169,58 +169,46 @@ struct Particles {
     /// Exchanges particles i and j (all fields).
     void swapEntries(std::size_t i, std::size_t j) {
         if (i == j) return;
-        auto sw = [&](auto& arr) { std::swap(arr[i], arr[j]); };
-        sw(x);
-        sw(v);
-        sw(w);
-        sw(radius);
-        sw(invMass);
-        sw(invInertia);
-        sw(material);
-        sw(flags);
-        sw(mass);
-        sw(id);
-        sw(image);
-        if (tdmState_) {
-            sw(f);
-            sw(torque);
-        }
-        if (!shape.empty()) {
-            sw(shape);
-            sw(angle);
-        }
+        forEachArray([&](auto& arr) { std::swap(arr[i], arr[j]); });
     }
 
     /// Applies a permutation: new index k holds old particle order[k]. Used for spatial sorting. A shorter order
     /// permutes the first order.size() particles only.
     void permute(const std::vector<std::uint32_t>& order) {
-        auto apply = [&](auto& arr) {
+        forEachArray([&](auto& arr) {
             auto tmp = arr;
             for (std::size_t k = 0; k < order.size(); ++k) tmp[k] = arr[order[k]];
             arr.swap(tmp);
-        };
-        apply(x);
-        apply(v);
-        apply(w);
-        apply(radius);
-        apply(invMass);
-        apply(invInertia);
-        apply(material);
-        apply(flags);
-        apply(mass);
-        apply(id);
-        apply(image);
-        if (tdmState_) {
-            apply(f);
-            apply(torque);
-        }
-        if (!shape.empty()) {
-            apply(shape);
-            apply(angle);
-        }
+        });
     }
 
 private:
+    /// Calls op on every per-particle array the store holds now (forces and torques only while the time-driven
+    /// state is kept, shapes and orientations only once it holds a polygon): the one list of the fields that
+    /// follow a particle when it changes place.
+    template <class Op>
+    void forEachArray(Op&& op) {
+        op(x);
+        op(v);
+        op(w);
+        op(radius);
+        op(invMass);
+        op(invInertia);
+        op(material);
+        op(flags);
+        op(mass);
+        op(id);
+        op(image);
+        if (tdmState_) {
+            op(f);
+            op(torque);
+        }
+        if (!shape.empty()) {
+            op(shape);
+            op(angle);
+        }
+    }
+
     bool tdmState_ = true;
     bool motion_ = true;
 };
