@@ -46,7 +46,7 @@ Collision<D> collide(double e, IntegratorKind integ, bool wall, double gtOverGn,
     Vec<D> v0 = n * (-vn) + t * (gtOverGn * vn);
     if (wall) {
         w.particles.add(n * (a + gap), v0, Ang<D>::zero(), a, 1000, 0, 0);
-        Wall<D> wl{Vec<D>::zero(), n, Vec<D>::zero(), 0};
+        Wall<D> wl = Wall<D>::plane(Vec<D>::zero(), n, Vec<D>::zero(), 0);
         w.walls.push_back(wl);
     } else {
         // symmetric: relative velocity v0, each particle half of it

@@ -40,7 +40,7 @@ World<D> collisionWorld(bool wall, double ratio, double phase) {
     const Vec<D> v0 = n * (-kVn) + t * (ratio * kVn);
     if (wall) {
         w.particles.add(n * (kA + gap), v0, Ang<D>::zero(), kA, 1000, 0, 0);
-        w.walls.push_back(Wall<D>{Vec<D>::zero(), n, Vec<D>::zero(), 0});
+        w.walls.push_back(Wall<D>::plane(Vec<D>::zero(), n, Vec<D>::zero(), 0));
     } else {
         w.particles.add(n * (kA + 0.5 * gap), v0 * 0.5, Ang<D>::zero(), kA, 1000, 0, 0);
         w.particles.add(n * (-kA - 0.5 * gap), v0 * -0.5, Ang<D>::zero(), kA, 1000, 0, 1);

@@ -193,8 +193,8 @@ TEST(EdmEngine, MatchesReference3DMixedGravityFrozen) {
     // periodic in x, y; a floor and a ceiling along z; the lowest layer of particles frozen as obstacles
     w.domain.periodic[2] = false;
     const double L = w.domain.hi[2];
-    w.walls.push_back({Vec<3>::zero(), Vec<3>{{0, 0, 1}}, Vec<3>::zero(), 0});
-    w.walls.push_back({Vec<3>::filled(L), Vec<3>{{0, 0, -1}}, Vec<3>::zero(), 0});
+    w.walls.push_back(Wall<3>::plane(Vec<3>::zero(), Vec<3>{{0, 0, 1}}, Vec<3>::zero(), 0));
+    w.walls.push_back(Wall<3>::plane(Vec<3>::filled(L), Vec<3>{{0, 0, -1}}, Vec<3>::zero(), 0));
     for (int i = 0; i < 9; ++i) {
         w.particles.flags[i] |= kFrozen;
         w.particles.invMass[i] = 0;
@@ -371,7 +371,7 @@ TEST(EdmEngine, MovingWallPushesParticle) {
     w.domain.lo = Vec<3>::filled(-5);
     w.domain.hi = Vec<3>::filled(5);
     // piston at x = 1 moving with -1 m/s, normal -x; particle at rest at x = 0.5, radius 0.1: contact at t = 0.4
-    w.walls.push_back({Vec<3>{{1, 0, 0}}, Vec<3>{{-1, 0, 0}}, Vec<3>{{-1, 0, 0}}, 0});
+    w.walls.push_back(Wall<3>::plane(Vec<3>{{1, 0, 0}}, Vec<3>{{-1, 0, 0}}, Vec<3>{{-1, 0, 0}}, 0));
     w.particles.add(Vec<3>::zero() + Vec<3>{{0.5, 0, 0}}, Vec<3>::zero(), Ang<3>::zero(), 0.1, 1.0, 0, 0);
     EdmEngine<3> eng(w, EdmSettings{});
     eng.advanceTo(1.0);
@@ -412,7 +412,7 @@ World<3> bouncingBall(double e) {
     w.domain.lo = Vec<3>::filled(-1);
     w.domain.hi = Vec<3>::filled(1);
     w.domain.gravity = Vec<3>{{0, 0, -9.81}};
-    w.walls.push_back({Vec<3>{{0, 0, -1}}, Vec<3>{{0, 0, 1}}, Vec<3>::zero(), 0});
+    w.walls.push_back(Wall<3>::plane(Vec<3>{{0, 0, -1}}, Vec<3>{{0, 0, 1}}, Vec<3>::zero(), 0));
     w.particles.add(Vec<3>{{0, 0, 0}}, Vec<3>{{0.3, 0, 0}}, Ang<3>::zero(), 0.05, 1000, 0, 0);
     return w;
 }

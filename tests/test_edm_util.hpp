@@ -61,9 +61,9 @@ World<D> makeGas(const GasSpec& g, const ContactSetup& cs) {
     w.domain.gravity[D - 1] = -g.gravity;
     if (!g.periodic) {
         for (int k = 0; k < D; ++k) {
-            Wall<D> lo{Vec<D>::zero(), Vec<D>::zero(), Vec<D>::zero(), 0};
+            Wall<D> lo = Wall<D>::plane(Vec<D>::zero(), Vec<D>::zero(), Vec<D>::zero(), 0);
             lo.normal[k] = 1;
-            Wall<D> hi{Vec<D>::filled(L), Vec<D>::zero(), Vec<D>::zero(), 0};
+            Wall<D> hi = Wall<D>::plane(Vec<D>::filled(L), Vec<D>::zero(), Vec<D>::zero(), 0);
             hi.normal[k] = -1;
             w.walls.push_back(lo);
             w.walls.push_back(hi);

@@ -164,7 +164,7 @@ InclineResult incline(double thetaDeg, double mu, TangentialLaw tang, Integrator
     const double kOverM = (kPi * kPi + std::log(e) * std::log(e)) / (tc * tc);
     const double delta0 = g * std::cos(theta) / kOverM;
     w.particles.add(n * (a - delta0), Vec<D>::zero(), Ang<D>::zero(), a, rho, 0, 0);
-    w.walls.push_back(Wall<D>{Vec<D>::zero(), n, Vec<D>::zero(), 0});
+    w.walls.push_back(Wall<D>::plane(Vec<D>::zero(), n, Vec<D>::zero(), 0));
     w.contact = buildContactSetup<D>(sc, testing::statsOf(w.particles, 1));
     TdmSettings s;
     s.integrator = integ;
@@ -309,7 +309,7 @@ HeadOnMeasure hertzHeadOn(const Scenario& sc, const HertzMaterial& hm, double v,
         const double gap = v * dt * 3.3;
         if (wall) {
             w.particles.add(n * (a + gap), n * (-v), Ang<3>::zero(), a, hm.density, 0, 0);
-            w.walls.push_back(Wall<3>{Vec<3>::zero(), n, Vec<3>::zero(), 0});
+            w.walls.push_back(Wall<3>::plane(Vec<3>::zero(), n, Vec<3>::zero(), 0));
         } else {
             w.particles.add(n * (a + 0.5 * gap), n * (-0.5 * v), Ang<3>::zero(), a, hm.density, 0, 0);
             w.particles.add(n * (-a - 0.5 * gap), n * (0.5 * v), Ang<3>::zero(), a, hm.density, 0, 1);

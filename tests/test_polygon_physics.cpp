@@ -59,7 +59,7 @@ FloorScene blockOnFloor(std::vector<V2> body, double thetaDeg, double mu, double
     const double h = -ymin, mg = p.mass[0] * g * std::cos(th);
     const double delta = 4 * mg * h / (kYoung * b + 2 * mg);
     f.w.particles.x[0] = V2{{0, h - delta}};
-    f.w.walls.push_back(Wall<2>{V2::zero(), V2{{0, 1}}, V2::zero(), 0});
+    f.w.walls.push_back(Wall<2>::plane(V2::zero(), V2{{0, 1}}, V2::zero(), 0));
     f.w.contact = buildContactSetup<2>(sc, materialStats(f.w.particles, 1));
     f.s.integrator = IntegratorKind::Gear5;
     f.s.dt = f.w.contact.polygonStep;

@@ -1,7 +1,10 @@
 #pragma once
 // Simulation box: bounds, periodic axes, gravity; and plane walls.
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <numbers>
+#include <string>
 
 #include "core/vec.hpp"
 
@@ -40,17 +43,56 @@ struct Domain {
     }
 };
 
-/// An infinite plane wall moving with constant velocity. The normal points into the domain.
+/// An infinite plane wall, translating with a constant velocity and optionally oscillating about that motion
+/// (a vibrated floor, docs/physics.md H.1): point(t) = point + v t + A (sin(2 pi f t + phi) - sin phi). The normal
+/// points into the domain.
 template <int D>
 struct Wall {
     Vec<D> point;     ///< a point of the plane at time 0 [m]
     Vec<D> normal;    ///< unit normal into the domain
     Vec<D> velocity;  ///< [m/s]
     int material = 0;
+    Vec<D> amplitude;      ///< oscillation amplitude A [m]
+    double frequency = 0;  ///< oscillation frequency f [Hz]; 0 = none
+    double phase = 0;      ///< oscillation phase phi [rad]
+    std::string name;      ///< named walls report their load (series.csv); may be empty
+    int id = 0;            ///< the wall's place among the scenario's walls, 0-based (outputs number walls by it)
+    /// Where the plane is and how fast it moves at the time of the current force pass (moveTo).
+    Vec<D> pointNow, velocityNow;
 
-    Vec<D> pointAt(double t) const { return point + velocity * t; }
+    /// A plane through `p` with unit normal `n`, moving with velocity `v`, at time 0.
+    static Wall plane(const Vec<D>& p, const Vec<D>& n, const Vec<D>& v, int material) {
+        Wall w;
+        w.point = p;
+        w.normal = n;
+        w.velocity = v;
+        w.material = material;
+        w.moveTo(0);
+        return w;
+    }
+    bool oscillates() const { return frequency != 0; }
+    Vec<D> pointAt(double t) const {
+        Vec<D> p = point + velocity * t;
+        if (oscillates()) {
+            const double w = 2 * std::numbers::pi * frequency;
+            p += amplitude * (std::sin(w * t + phase) - std::sin(phase));
+        }
+        return p;
+    }
+    Vec<D> velocityAt(double t) const {
+        if (!oscillates()) return velocity;
+        const double w = 2 * std::numbers::pi * frequency;
+        return velocity + amplitude * (w * std::cos(w * t + phase));
+    }
+    /// Sets pointNow and velocityNow to time t: once before every force pass, which reads only them.
+    void moveTo(double t) {
+        pointNow = pointAt(t);
+        velocityNow = velocityAt(t);
+    }
     /// Signed distance of x from the plane at time t (positive inside the domain) [m].
     double distance(const Vec<D>& x, double t) const { return dot(normal, x - pointAt(t)); }
+    /// The same at the time of moveTo.
+    double distanceNow(const Vec<D>& x) const { return dot(normal, x - pointNow); }
 };
 
 }  // namespace haet

@@ -237,6 +237,40 @@ void writeVtpWalls(const std::filesystem::path& path, const std::vector<WallQuad
     arrays.write(path, head);
 }
 
+void writeVtpShapes(const std::filesystem::path& path, const WallShapes& sh) {
+    const std::size_t np = sh.points.size(), nl = sh.lineWall.size(), npoly = sh.polyWall.size();
+    std::vector<double> xyz;
+    xyz.reserve(3 * np);
+    for (const auto& p : sh.points) xyz.insert(xyz.end(), p.begin(), p.end());
+    // Cell data runs over verts, lines, polys, strips in that order.
+    std::vector<std::int32_t> ids(sh.lineWall);
+    ids.insert(ids.end(), sh.polyWall.begin(), sh.polyWall.end());
+    AppendedArrays arrays;
+    std::string head = fileHead("PolyData");
+    head += "  <PolyData>\n";
+    head += fmt::format(
+        "    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"0\" NumberOfLines=\"{}\" NumberOfStrips=\"0\" "
+        "NumberOfPolys=\"{}\">\n",
+        np, nl, npoly);
+    head += "      <CellData>\n" +
+            arrays.tag("wall_id", VtkField::Int32, 1, nl + npoly, arrays.keep(std::move(ids)), 8) +
+            "      </CellData>\n";
+    head += "      <Points>\n" + arrays.tag("Points", VtkField::Float64, 3, np, arrays.keep(std::move(xyz)), 8) +
+            "      </Points>\n";
+    auto cells = [&](const char* tagName, const std::vector<std::int64_t>& index,
+                     const std::vector<std::int64_t>& first) {
+        head += fmt::format("      <{}>\n", tagName);
+        head += arrays.tag("connectivity", VtkField::Int64, 1, index.size(), index.data(), 8);
+        head += arrays.tag("offsets", VtkField::Int64, 1, first.size() - 1, first.data() + 1, 8);
+        head += fmt::format("      </{}>\n", tagName);
+    };
+    cells("Lines", sh.lineIndex, sh.lineFirst);
+    cells("Polys", sh.polyIndex, sh.polyFirst);
+    head += "    </Piece>\n";
+    head += "  </PolyData>\n";
+    arrays.write(path, head);
+}
+
 void writeVtiCells(const std::filesystem::path& path, std::array<int, 3> dims, std::array<double, 3> origin,
                    std::array<double, 3> spacing, const std::vector<VtkField>& cellData, double time) {
     std::size_t n = 1;

@@ -51,6 +51,39 @@ struct WallQuad {
 /// Writes the walls as PolyData, one polygon per wall.
 void writeVtpWalls(const std::filesystem::path& path, const std::vector<WallQuad>& quads);
 
+/// Walls drawn as lines (segments, arcs) and polygons (plane patches, triangles, tessellated cylinders and discs),
+/// each cell with the index of its wall. A cell is a run of point indices: cells [first[k], first[k+1]) of `index`.
+struct WallShapes {
+    std::vector<std::array<double, 3>> points;  ///< [m]
+    std::vector<std::int64_t> lineIndex, lineFirst{0};
+    std::vector<std::int32_t> lineWall;
+    std::vector<std::int64_t> polyIndex, polyFirst{0};
+    std::vector<std::int32_t> polyWall;
+
+    std::int64_t point(double x, double y, double z) {
+        points.push_back({x, y, z});
+        return static_cast<std::int64_t>(points.size()) - 1;
+    }
+    void line(std::initializer_list<std::int64_t> ids, int wall) { cell(lineIndex, lineFirst, lineWall, ids, wall); }
+    void poly(std::initializer_list<std::int64_t> ids, int wall) { cell(polyIndex, polyFirst, polyWall, ids, wall); }
+    void add(const WallQuad& q) {
+        std::int64_t ids[4];
+        for (int v = 0; v < 4; ++v) ids[v] = point(q.corners[v][0], q.corners[v][1], q.corners[v][2]);
+        poly({ids[0], ids[1], ids[2], ids[3]}, q.id);
+    }
+
+private:
+    static void cell(std::vector<std::int64_t>& index, std::vector<std::int64_t>& first,
+                     std::vector<std::int32_t>& wall, std::initializer_list<std::int64_t> ids, int w) {
+        index.insert(index.end(), ids.begin(), ids.end());
+        first.push_back(static_cast<std::int64_t>(index.size()));
+        wall.push_back(w);
+    }
+};
+
+/// Writes walls of any shape as PolyData (cell data "wall_id"). Throws IoError.
+void writeVtpShapes(const std::filesystem::path& path, const WallShapes& shapes);
+
 /// A ParaView .pvd collection. The file is rewritten atomically on construction and on every add(), so a
 /// run that stops at any point leaves a valid collection of the snapshots written so far. Each rewrite is
 /// O(entries); fine for the thousands of snapshots a run writes.

@@ -180,14 +180,14 @@ public:
           history_(ctx.wallHistory),
           x_(ctx.p.x.data()),
           radius_(ctx.p.radius.data()),
-          shape_(ctx.p.shape.data()),
-          time_(ctx.time) {}
+          shape_(ctx.p.shape.data()) {}
 
     [[gnu::always_inline]] bool add(std::size_t i, std::size_t w, V2& f, Ang<2>& tq, double& worst) const {
         if (shape_[i] == kNoShape) return disk_.add(i, w, f, tq, worst);
         // Most walls are beyond the bounding circle: that test first, the overlap out of line.
-        const double dist = walls_[w].distance(x_[i], time_);
+        const double dist = walls_[w].distanceNow(x_[i]);
         V2& hist = history_[i * nw_ + w];
+        if (ctx_.planeForce) ctx_.planeForce[i * nw_ + w] = V2::zero();
         if (dist >= radius_[i]) {
             if (!(hist == V2::zero())) hist = V2::zero();
             return false;
@@ -195,6 +195,12 @@ public:
         double energy;
         return contact<false>(i, w, dist, hist, f, tq, worst, energy);
     }
+
+    /// Walls of any shape touch the disks among the polygons (a scene with polygons has none: the loader says so).
+    [[gnu::always_inline]] std::uint32_t addSurfaces(std::size_t i, V2& f, Ang<2>& tq, double& worst) const {
+        return shape_[i] == kNoShape ? disk_.addSurfaces(i, f, tq, worst) : 0;
+    }
+    double surfaceEnergy(std::size_t i) const { return shape_[i] == kNoShape ? disk_.surfaceEnergy(i) : 0.0; }
 
     /// The energy of wall w's contact with particle i at the current state [J]: a disk's by its law, a polygon's
     /// from its overlap (the spring copied, not changed).
@@ -204,7 +210,7 @@ public:
         V2 hist = history_[i * nw_ + w], f = V2::zero();
         Ang<2> tq = Ang<2>::zero();
         double worst = 0, energy = 0;
-        const double dist = walls_[w].distance(x_[i], time_);
+        const double dist = walls_[w].distanceNow(x_[i]);
         if (dist >= radius_[i]) return 0.0;
         return contact<true>(i, w, dist, hist, f, tq, worst, energy) ? energy : 0.0;
     }
@@ -227,8 +233,8 @@ private:
         }
         const BodyState bi = bodyOf(ctx_.p, ctx_.sv, ctx_.sw, i);
         BodyState bw;
-        bw.v = wall.velocity;
-        bw.vStep = wall.velocity;
+        bw.v = wall.velocityNow;
+        bw.vStep = wall.velocityNow;
         const PolygonCoeffs& pc = ctx_.cs.polygonPair(ctx_.p.material[i], wall.material);
         const PairLengths len = wallLengths(ri);
         const ContactForce cf = polygonContact<Law, Tangential::kHasHistory>(pc, o, bi, bw, &wall.normal, len,
@@ -239,6 +245,7 @@ private:
         }
         f += cf.f;
         tq[0] += cf.torqueI;
+        if (ctx_.planeForce) ctx_.planeForce[i * nw_ + w] = cf.f;
         const double clen = norm(o.chord);
         worst = std::max(worst, clen > 0 ? o.area / clen / ri : 1.0);
         return true;
@@ -253,7 +260,6 @@ private:
     const V2* x_;
     const double* radius_;
     const std::uint32_t* shape_;
-    double time_;
 };
 
 /// The kernel of the pair pass for scenes with polygons (tdm/pair_pass.hpp has the interface). Normal, Tangential:

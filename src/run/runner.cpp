@@ -22,6 +22,7 @@
 #include "io/series.hpp"
 #include "io/vtk.hpp"
 #include "polygon/output.hpp"
+#include "run/walls_output.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
 
@@ -88,7 +89,7 @@ public:
 template <int D>
 class TdmDriver final : public Driver<D> {
 public:
-    TdmDriver(World<D>& w, const TdmSettings& s, std::string dtNote) : eng_(w, s), note_(std::move(dtNote)) {}
+    TdmDriver(World<D>& w, const TdmSettings& s, std::string dtNote) : w_(w), eng_(w, s), note_(std::move(dtNote)) {}
     const char* method() const override { return "tdm"; }
     void advanceTo(double t) override { eng_.advanceTo(t); }
     double timeTolerance() const override { return 0.5 * eng_.settings().dt; }
@@ -97,8 +98,16 @@ public:
     double maxOverlapRatio() const override { return eng_.forceStats().maxOverlapRatio; }
     double elasticEnergy() const override { return eng_.contactEnergy(); }
     double virial(double) override { return eng_.pairVirial(); }
-    std::vector<std::string> extraColumns() const override { return {"rebuilds"}; }
-    std::vector<std::optional<double>> extraRow() const override { return {double(eng_.rebuilds())}; }
+    std::vector<std::string> extraColumns() const override {
+        std::vector<std::string> c{"rebuilds"};
+        for (std::string& name : wallLoadColumns(w_)) c.push_back(std::move(name));
+        return c;
+    }
+    std::vector<std::optional<double>> extraRow() const override {
+        std::vector<std::optional<double>> r{double(eng_.rebuilds())};
+        appendWallLoads(w_, eng_, r);
+        return r;
+    }
     void describe(JsonObject& j) const override {
         j.add("dt", eng_.settings().dt);
         j.add("dt_rule", note_);
@@ -107,6 +116,7 @@ public:
     const TdmEngine<D>& engine() const { return eng_; }
 
 private:
+    const World<D>& w_;
     TdmEngine<D> eng_;
     std::string note_;
 };
@@ -272,9 +282,9 @@ public:
                 polys_->add(time, pname);
             }
         }
-        if (!w.walls.empty()) {
+        if (!w.walls.empty() || !w.surfaces.empty()) {
             const std::string wname = fmt::format("walls_{:06d}.vtp", count_);
-            writeVtpWalls(dir_ / wname, wallQuads(w, time));
+            writeVtpShapes(dir_ / wname, wallShapes(w, time));
             walls_.add(time, wname);
         }
         ++count_;
@@ -302,46 +312,6 @@ private:
         writeVtiCells(dir_ / name, dims, origin, spacing,
                       {{"label", 1, VtkField::Int32, label.data()}, {"phi", 1, VtkField::Float64, phi.data()}}, time);
         zones_.add(time, name);
-    }
-
-    /// A wall as a square patch covering the box (a thin quad in 2D).
-    static std::vector<WallQuad> wallQuads(const World<D>& w, double time) {
-        std::vector<WallQuad> quads;
-        const Vec<D> L = w.domain.length();
-        double size = 0;
-        for (int k = 0; k < D; ++k) size = std::max(size, L[k]);
-        for (std::size_t q = 0; q < w.walls.size(); ++q) {
-            const Wall<D>& wl = w.walls[q];
-            std::array<double, 3> c{0, 0, 0}, n{0, 0, 0};
-            const Vec<D> pt = wl.pointAt(time);
-            for (int k = 0; k < D; ++k) {
-                c[k] = pt[k];
-                n[k] = wl.normal[k];
-            }
-            // Centre the patch on the box centre projected onto the plane.
-            std::array<double, 3> mid{0, 0, 0};
-            for (int k = 0; k < D; ++k) mid[k] = 0.5 * (w.domain.lo[k] + w.domain.hi[k]);
-            double off = 0;
-            for (int k = 0; k < 3; ++k) off += (mid[k] - c[k]) * n[k];
-            for (int k = 0; k < 3; ++k) c[k] = mid[k] - off * n[k];
-            // Two tangent directions.
-            std::array<double, 3> a =
-                std::abs(n[0]) < 0.9 ? std::array<double, 3>{1, 0, 0} : std::array<double, 3>{0, 1, 0};
-            if (D == 2) a = {-n[1], n[0], 0};
-            double an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
-            for (int k = 0; k < 3; ++k) a[k] -= an * n[k];
-            double al = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-            for (int k = 0; k < 3; ++k) a[k] /= al;
-            std::array<double, 3> b{n[1] * a[2] - n[2] * a[1], n[2] * a[0] - n[0] * a[2], n[0] * a[1] - n[1] * a[0]};
-            const double ha = 0.5 * size, hb = D == 2 ? 0.01 * size : 0.5 * size;
-            WallQuad wq;
-            wq.id = static_cast<int>(q);
-            const double sa[4] = {-1, 1, 1, -1}, sb[4] = {-1, -1, 1, 1};
-            for (int v = 0; v < 4; ++v)
-                for (int k = 0; k < 3; ++k) wq.corners[v][k] = c[k] + sa[v] * ha * a[k] + sb[v] * hb * b[k];
-            quads.push_back(wq);
-        }
-        return quads;
     }
 
     std::filesystem::path dir_;
@@ -379,12 +349,7 @@ void writePicture(const World<2>& w, const std::filesystem::path& path, bool byM
         else
             scene.disks.push_back({p.x[i][0], p.x[i][1], p.radius[i], colour});
     }
-    for (const Wall<2>& wl : w.walls) {
-        const Vec<2> pt = wl.pointAt(w.time);
-        const Vec<2> t{{-wl.normal[1], wl.normal[0]}};
-        const double L = norm(w.domain.length());
-        scene.walls.push_back({pt[0] - t[0] * L, pt[1] - t[1] * L, pt[0] + t[0] * L, pt[1] + t[1] * L});
-    }
+    addWallLines(w, scene);
     if (byMode)
         scene.caption = fmt::format("t = {:.4g} s, {} particles: {} time-driven (blue), {} event-driven (orange)",
                                     w.time, p.size(), p.tdmCount(), p.size() - p.tdmCount());
@@ -575,7 +540,8 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
     out << fmt::format("particles  {} ({} frozen), {} materials, {} walls\n", n,
                        std::count_if(world.particles.flags.begin(), world.particles.flags.end(),
                                      [](std::uint8_t f) { return f & kFrozen; }),
-                       sc.materials.size(), world.walls.size());
+                       sc.materials.size(), world.walls.size() + world.surfaces.size());
+    describeWalls(world, out);
     if (world.particles.hasPolygons())
         out << fmt::format("polygons   {} ({}; the rest are disks)\n", world.particles.shapes.size(),
                            sc.contact.polygonLaw == PolygonLaw::Potential

@@ -100,12 +100,41 @@ struct HaetDef {
     SourcePos pos;
 };
 
+/// The shape of a [[walls]] block (docs/scenario.md, "[[walls]]").
+enum class WallType { Plane, Segment, Polyline, Circle, Arc, Mesh, Cylinder, Cone, Disc, Rectangle };
+
 struct WallDef {
-    Vec3d point{0, 0, 0};     ///< a point on the plane [m]
-    Vec3d normal{0, 0, 1};    ///< unit normal pointing into the domain (normalised by the loader)
-    Vec3d velocity{0, 0, 0};  ///< translation velocity of the plane [m/s]
+    WallType type = WallType::Plane;
+    std::string name;         ///< optional: a named wall's load is in series.csv
+    Vec3d point{0, 0, 0};     ///< plane: a point on it [m]
+    Vec3d normal{0, 0, 1};    ///< plane: unit normal pointing into the domain; disc, rectangle: their normal
+    Vec3d velocity{0, 0, 0};  ///< translation velocity [m/s]
     int material = 0;         ///< index into Scenario::materials
+    // Oscillation about the translation: displacement A (sin(2 pi f t + phase) - sin(phase)).
+    Vec3d amplitude{0, 0, 0};  ///< [m]
+    double frequency = 0;      ///< [Hz]; 0 = none
+    double phase = 0;          ///< [rad]
+    // Rotation about an axis through `rotationCentre` (2D: about z).
+    Vec3d rotationCentre{0, 0, 0};  ///< [m]
+    Vec3d rotationAxis{0, 0, 1};    ///< unit vector (3D)
+    double omega = 0;               ///< angular speed [rad/s]; 0 = none
+    // Shapes (body frame = world frame at t = 0).
+    std::vector<Vec3d> points;      ///< segment, polyline: the vertices [m]
+    bool closed = false;            ///< polyline: joins the last point to the first
+    Vec3d centre{0, 0, 0};          ///< circle, arc, disc, rectangle: the centre; cylinder, cone: the base centre [m]
+    Vec3d axis{0, 0, 1};            ///< cylinder, cone: unit axis from the base
+    double radius = 0;              ///< circle, arc, disc; cylinder; cone: at the base [m]
+    double radiusTop = 0;           ///< cone: at the top [m]
+    double length = 0;              ///< cylinder, cone: along the axis [m]
+    double angle0 = 0, angle1 = 0;  ///< arc: from, to, counter-clockwise [rad]
+    bool capBase = false, capTop = false;         ///< cylinder, cone: discs closing the ends
+    Vec3d edge1{0, 0, 0}, edge2{0, 0, 0};         ///< rectangle: its two edge vectors [m]
+    std::vector<std::array<Vec3d, 3>> triangles;  ///< mesh: the triangles, transformed as the file asks [m]
+    std::string file;                             ///< mesh: the STL file it came from (resolved path)
     SourcePos pos;
+
+    bool isPlane() const { return type == WallType::Plane; }
+    bool rotates() const { return omega != 0; }
 };
 
 struct InsertDef {

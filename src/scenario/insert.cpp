@@ -16,6 +16,7 @@
 #include "core/polygon_shape.hpp"
 #include "neighbor/cell_grid.hpp"
 #include "scenario/text.hpp"
+#include "scenario/walls.hpp"
 
 namespace haet {
 namespace {
@@ -94,17 +95,6 @@ Vec<D> toVec(const Vec3d& a) {
     Vec<D> v;
     for (int k = 0; k < D; ++k) v[k] = a[std::size_t(k)];
     return v;
-}
-
-/// True when a sphere (disk) of radius r at x lies on the inner side of every wall plane, clear of it by r.
-template <int D>
-bool clearOfWalls(const std::vector<WallDef>& walls, const Vec<D>& x, double r) {
-    for (const WallDef& w : walls) {
-        double dist = 0;
-        for (int k = 0; k < D; ++k) dist += (x[k] - w.point[std::size_t(k)]) * w.normal[std::size_t(k)];
-        if (dist < r) return false;
-    }
-    return true;
 }
 
 /// Linked-cell grid over a box, for the overlap test of a candidate against the particles placed so far.
@@ -258,6 +248,7 @@ std::vector<NewParticle<D>> insertLattice(const Scenario& s, std::size_t k, cons
     }
     OverlapGrid<D> grid = gridWithExisting(store, lo, hi, in.radiusMax, in.count);
     const MaterialDef& mat = s.materials[std::size_t(in.material)];
+    const WallClearance<D> walls(s.walls);
     std::vector<NewParticle<D>> out;
     std::array<std::uint64_t, D> site{};  // axis 0 runs fastest, so a lattice under gravity fills from the bottom up
     bool sitesLeft = true;
@@ -267,7 +258,7 @@ std::vector<NewParticle<D>> insertLattice(const Scenario& s, std::size_t k, cons
         for (int a = 0; a < D; ++a)
             p.x[a] = std::min(lo[a] + in.radiusMax + double(site[a]) * spacing, hi[a] - in.radiusMax);
         p.radius = rng.uniform(in.radiusMin, in.radiusMax);
-        if (clearOfWalls(s.walls, p.x, p.radius) && !grid.overlaps(p.x, p.radius)) {
+        if (walls.clear(p.x, p.radius) && !grid.overlaps(p.x, p.radius)) {
             makePolygon(in, p, rng);
             p.density = mat.density;
             p.material = std::uint16_t(in.material);
@@ -293,6 +284,7 @@ std::vector<NewParticle<D>> insertRandom(const Scenario& s, std::size_t k, const
     const std::uint64_t maxConsecutive = 20000;
     const std::uint64_t maxTotal = 200 * std::uint64_t(in.count) + 100000;
     std::uint64_t attempts = 0;
+    const WallClearance<D> walls(s.walls);
     std::vector<NewParticle<D>> out;
     out.reserve(in.count);
     for (std::size_t i = 0; i < in.count; ++i) {
@@ -302,7 +294,7 @@ std::vector<NewParticle<D>> insertRandom(const Scenario& s, std::size_t k, const
         for (std::uint64_t tries = 0; tries < maxConsecutive && attempts < maxTotal && !placed; ++tries) {
             ++attempts;
             for (int a = 0; a < D; ++a) p.x[a] = lo[a] + p.radius + (hi[a] - lo[a] - 2 * p.radius) * rng.uniform();
-            placed = clearOfWalls(s.walls, p.x, p.radius) && !grid.overlaps(p.x, p.radius);
+            placed = walls.clear(p.x, p.radius) && !grid.overlaps(p.x, p.radius);
         }
         if (!placed)
             throw ScenarioError(in.pos, insertKey(k) + ".count",

@@ -20,6 +20,9 @@ TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s
         integ_ = std::move(vv);
     }
     wallHistory_.assign(w_.particles.tdmCount() * w_.walls.size(), Vec<D>::zero());
+    surf_.walls = &w_.surfaces;
+    if (s_.planeLoads) planeForce_.assign(w_.particles.tdmCount() * w_.walls.size(), Vec<D>::zero());
+    moveWalls();
     rebuild(s_.sortEvery > 0);
     motion_.v = w_.particles.v;
     motion_.w = w_.particles.w;
@@ -33,8 +36,12 @@ TdmEngine<D>::~TdmEngine() = default;
 template <int D>
 ForceContext<D> TdmEngine<D>::context(const Vec<D>* sv, const Ang<D>* sw) const {
     // A force pass writes the pair list's and the walls' springs; the energy pass (const) only reads them.
-    return forceContext(w_.particles, const_cast<PairList<D>&>(pairs_), w_.walls,
-                        const_cast<std::vector<Vec<D>>&>(wallHistory_), w_.contact, w_.domain, w_.time, s_.dt, sv, sw);
+    ForceContext<D> ctx =
+        forceContext(w_.particles, const_cast<PairList<D>&>(pairs_), w_.walls,
+                     const_cast<std::vector<Vec<D>>&>(wallHistory_), w_.contact, w_.domain, w_.time, s_.dt, sv, sw);
+    if (!planeForce_.empty()) ctx.planeForce = const_cast<Vec<D>*>(planeForce_.data());
+    if (!surf_.empty()) ctx.surfaces = const_cast<SurfaceState<D>*>(&surf_);
+    return ctx;
 }
 
 template <int D>
@@ -51,10 +58,8 @@ void TdmEngine<D>::computeForces(bool correct, std::atomic<bool>* nextMoved) {
     auto run = [&](auto normal, auto tangential) {
         using N = decltype(normal);
         using T = decltype(tangential);
-        auto forces = [&](auto then) {
-            stats_ = haet::computeForces<D, N, T>(w_.particles, pairs_, w_.walls, wallHistory_, cs, w_.domain, w_.time,
-                                                  s_.dt, motion_.v.data(), motion_.w.data(), scratch_, then);
-        };
+        const ForceContext<D> ctx = context(motion_.v.data(), motion_.w.data());
+        auto forces = [&](auto then) { stats_ = computeForcesIn<D, N, T>(ctx, scratch_, then); };
         // Verlet's corrector needs nothing but the particle's own new force: it runs inside the force pass, and
         // so does the next step's predictor when that step follows at once (advanceTo).
         if (correct && verlet_ && nextMoved) {
@@ -90,6 +95,7 @@ void TdmEngine<D>::rebuild(bool sort) {
     // Only the contacts' springs carry over into the new list: the old list shrinks to them first, so that it
     // never coexists in full with the new one, nor with the copies a sort makes.
     keepTouchingPairs(pairs_);
+    std::vector<std::uint32_t> sortOrder;
     if (sort) {
         double rmax = 0;
         for (std::size_t i = 0; i < n; ++i) rmax = std::max(rmax, p.radius[i]);
@@ -112,12 +118,100 @@ void TdmEngine<D>::rebuild(bool sort) {
             wallHistory_.swap(wh);
         }
         lastSort_ = steps_;
+        if (!surf_.empty()) sortOrder.assign(order.begin(), order.end());
     }
     PairList<D> fresh;
     buildPairList(p, w_.domain, NeighborSettings{s_.skin, true}, pairs_, fresh);
     pairs_ = std::move(fresh);
     xAtBuild_.assign(p.x.begin(), p.x.begin() + static_cast<std::ptrdiff_t>(n));
     ++rebuilds_;
+    if (!surf_.empty()) buildCandidates(sortOrder.empty() ? nullptr : sortOrder.data());
+}
+
+template <int D>
+void TdmEngine<D>::moveWalls() {
+    for (Wall<D>& wall : w_.walls) wall.moveTo(w_.time);
+    if (surf_.empty()) return;
+    const auto& walls = w_.surfaces;
+    surf_.poses.resize(walls.size());
+    bool far = false;
+    for (std::size_t q = 0; q < walls.size(); ++q) {
+        const Motion<D>& m = walls[q].motion;
+        surf_.poses[q] = m.at(w_.time);
+        // Particles move up to skin/2 before the pair list (and with it the candidates) is rebuilt; a wall may
+        // close in by the other half (surface_list.hpp).
+        if (m.moves() && !surf_.candidates.first.empty() &&
+            m.maxDisplacement(surf_.candidatesTime, w_.time, walls[q].reachFrom(m.centre)) > 0.5 * s_.skin)
+            far = true;
+    }
+    if (far && surf_.slotOf.size() == w_.particles.tdmCount()) buildCandidates(nullptr);
+}
+
+template <int D>
+void TdmEngine<D>::buildCandidates(const std::uint32_t* from) {
+    const Particles<D>& p = w_.particles;
+    const std::size_t n = p.tdmCount();
+    buildSurfaceCandidates(p, n, w_.domain, w_.surfaces, surf_.poses, s_.skin, surf_.candidates);
+    surf_.candidatesTime = w_.time;
+    std::vector<std::uint32_t> slotOf(n, SurfaceState<D>::kNoSlots);
+    std::vector<std::uint8_t> count(n, 0);
+    std::vector<SurfaceContact<D>> slots;
+    for (std::size_t k = 0; k < n; ++k) {
+        if (surf_.candidates.first[k + 1] == surf_.candidates.first[k]) continue;
+        slotOf[k] = static_cast<std::uint32_t>(slots.size());
+        slots.resize(slots.size() + kSurfaceSlots);
+        const std::uint32_t o = from ? from[k] : static_cast<std::uint32_t>(k);
+        if (o == kFresh || o >= surf_.slotOf.size() || surf_.slotOf[o] == SurfaceState<D>::kNoSlots) continue;
+        count[k] = surf_.count[o];
+        std::copy_n(surf_.slots.begin() + surf_.slotOf[o], kSurfaceSlots, slots.begin() + slotOf[k]);
+    }
+    surf_.slotOf.swap(slotOf);
+    surf_.count.swap(count);
+    surf_.slots.swap(slots);
+}
+
+template <int D>
+typename TdmEngine<D>::WallLoad TdmEngine<D>::planeLoad(std::size_t w) const {
+    WallLoad l{};
+    if (planeForce_.empty()) return l;
+    const Particles<D>& p = w_.particles;
+    const Wall<D>& wall = w_.walls[w];
+    const std::size_t nw = w_.walls.size();
+    for (std::size_t i = 0; i < p.tdmCount(); ++i) {
+        const Vec<D>& f = planeForce_[i * nw + w];
+        if (f == Vec<D>::zero()) continue;
+        const Vec<D> at = p.x[i] - wall.normal * wall.distanceNow(p.x[i]);  // the contact point on the plane
+        l.force -= f;
+        l.torque -= cross(at - wall.pointNow, f);
+    }
+    return l;
+}
+
+template <int D>
+typename TdmEngine<D>::WallLoad TdmEngine<D>::surfaceLoad(std::size_t w) const {
+    WallLoad l{};
+    if (surf_.empty()) return l;
+    const Vec<D> c = surf_.poses[w].centre;
+    for (std::size_t i = 0; i < surf_.slotOf.size(); ++i) {
+        if (surf_.slotOf[i] == SurfaceState<D>::kNoSlots) continue;
+        for (int q = 0; q < surf_.count[i]; ++q) {
+            const SurfaceContact<D>& k = surf_.slots[surf_.slotOf[i] + q];
+            if (k.wall != w) continue;
+            l.force -= k.force;
+            l.torque -= cross(k.point - c, k.force);
+        }
+    }
+    return l;
+}
+
+template <int D>
+std::size_t TdmEngine<D>::wallContacts() const {
+    std::size_t n = 0;
+    const Particles<D>& p = w_.particles;
+    for (std::size_t i = 0; i < p.tdmCount(); ++i)
+        for (const Wall<D>& wall : w_.walls) n += wall.distanceNow(p.x[i]) < p.radius[i];
+    for (std::size_t i = 0; i < surf_.count.size(); ++i) n += surf_.count[i];
+    return n;
 }
 
 template <int D>
@@ -155,6 +249,8 @@ void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
     for (std::size_t k = 0; k < n; ++k) xb[k] = from[k] == kFresh ? p.x[k] : xAtBuild_[from[k]];
     xAtBuild_.swap(xb);
     remapPairList(p, w_.domain, NeighborSettings{s_.skin, true}, from, pairs_, xAtBuild_.data());
+    if (s_.planeLoads) planeForce_.assign(n * nw, Vec<D>::zero());
+    if (!surf_.empty()) buildCandidates(from.data());
 }
 
 template <int D>
@@ -174,7 +270,8 @@ void TdmEngine<D>::contactCounts(std::vector<std::uint8_t>& out) const {
             }
         }
         for (const Wall<D>& wall : w_.walls)
-            if (wall.distance(p.x[i], w_.time) < p.radius[i]) bump(out[i], 2);
+            if (wall.distanceNow(p.x[i]) < p.radius[i]) bump(out[i], 2);
+        if (i < surf_.count.size()) bump(out[i], 2 * surf_.count[i]);
     }
 }
 
@@ -188,6 +285,7 @@ template <int D>
 void TdmEngine<D>::finishStep(bool moved, std::atomic<bool>* nextMoved) {
     w_.time += s_.dt;
     ++steps_;
+    moveWalls();
     if (moved) rebuild(s_.sortEvery > 0 && steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery));
     computeForces(true, nextMoved);
     checkHealth();

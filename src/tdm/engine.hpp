@@ -12,6 +12,7 @@
 #include "tdm/forces.hpp"
 #include "tdm/integrators.hpp"
 #include "tdm/shape_pass.hpp"
+#include "tdm/surface_state.hpp"
 #include "world/world.hpp"
 
 namespace haet {
@@ -22,6 +23,7 @@ struct TdmSettings {
     double skin = 0;          ///< [m]
     double maxOverlap = 0.5;  ///< blow-up limit: overlap / smaller radius [-]
     int sortEvery = 1000;     ///< spatial re-sort period in steps (0 = never)
+    bool planeLoads = false;  ///< keep each plane contact's force, for the planes' loads (planeLoad)
 };
 
 template <int D>
@@ -59,6 +61,18 @@ public:
     /// Sum over contacts of r_ij . F_ij [J] (pair virial; walls excluded).
     double pairVirial() const;
 
+    /// The load the particles put on one wall at the last force pass: the force on it [N] and its torque about its
+    /// centre [N m] (a plane's point at the current time; a wall of any shape: its centre of rotation, moved with
+    /// it). Planes report theirs only with TdmSettings::planeLoads.
+    struct WallLoad {
+        Vec<D> force;
+        Ang<D> torque;
+    };
+    WallLoad planeLoad(std::size_t w) const;
+    WallLoad surfaceLoad(std::size_t w) const;
+    /// The walls' contacts with particles now (planes and walls of any shape) [-].
+    std::size_t wallContacts() const;
+
 private:
     /// Forces at the current (predicted) state; with correct, also the integrator's corrector; with nextMoved
     /// (velocity Verlet only), also the predictor of the next step, which sets *nextMoved as predict() returns.
@@ -68,6 +82,11 @@ private:
     /// The drift beyond which the pair list is rebuilt, squared: (skin / 2)^2.
     double driftLimit2() const { return 0.25 * s_.skin * s_.skin; }
     void rebuild(bool sort);
+    /// Planes and walls of any shape to the current time; the candidates rebuilt if a wall moved too far.
+    void moveWalls();
+    /// The broad phase of walls of any shape at the current poses; the contacts of new particle k are those of old
+    /// particle from[k] (kFresh: none; from null: the same particle).
+    void buildCandidates(const std::uint32_t* from);
     void checkHealth() const;
     /// The state a force pass reads and writes (sv, sw: the step's mean velocities).
     ForceContext<D> context(const Vec<D>* sv, const Ang<D>* sw) const;
@@ -80,6 +99,8 @@ private:
     ForceScratch<D> scratch_;
     StepMotion<D> motion_;
     std::vector<Vec<D>> wallHistory_;
+    std::vector<Vec<D>> planeForce_;  ///< with planeLoads: each (particle, plane) contact's force [N]
+    SurfaceState<D> surf_;
     std::vector<Vec<D>> xAtBuild_;
     ForceStats stats_;
     std::unique_ptr<ShapePass> shapes_;  ///< 2D scenes with polygons: their force pass

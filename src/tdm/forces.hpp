@@ -32,6 +32,13 @@ ForceStats computeForces(Particles<D>& p, PairList<D>& pl, const std::vector<Wal
     return runPairPass(ctx, kernel, s, then);
 }
 
+/// The same on a context made by the caller (the engine's, with its walls of any shape and plane loads).
+template <int D, class Normal, class Tangential, class Then>
+ForceStats computeForcesIn(const ForceContext<D>& ctx, ForceScratch<D>& s, Then then) {
+    const DiskKernel<D, Normal, Tangential, kLanePairs> kernel(ctx);
+    return runPairPass(ctx, kernel, s, then);
+}
+
 /// The elastic energy of the contacts of disks or spheres at the state ctx holds [J] (the normal law's).
 template <int D, class Normal>
 double diskContactEnergy(const ForceContext<D>& ctx) {

@@ -31,8 +31,9 @@
 //                      at once; false: block by block, the kernel filling a block's entries first:
 //   k.block<kCross>(b0, b1, e, cross, c, bl)  the entries of the block's pairs (see PairBlock), the cross pairs
 //                      (kCross: partner >= e) taken from cross[c...]; returns the entries' count
-//   k.walls()          the wall kernel W: W.add(i, w, f, torque, worst) adds wall w's contact (returns whether
-//                      it touches); W.energy(i, w) its elastic energy [J]
+//   k.walls()          the wall kernel W: W.add(i, w, f, torque, worst) adds plane w's contact (returns whether
+//                      it touches); W.energy(i, w) its elastic energy [J]; W.addSurfaces(i, f, torque, worst)
+//                      the contacts with walls of any shape (returns how many), W.surfaceEnergy(i) theirs
 //   k.energy(i, k)     the elastic energy of listed pair k [J] at the current state
 // The storage between a kernel's pairs and its particles' sums is the particles' f and torque arrays: the pass
 // starts them (gravity, zero), the kernel adds to them, the pass stores the final force and torque there.
@@ -50,6 +51,7 @@
 #include "neighbor/pair_list.hpp"
 #include "tdm/force_stats.hpp"
 #include "tdm/pair_block.hpp"
+#include "tdm/surface_state.hpp"
 
 namespace haet {
 
@@ -68,6 +70,8 @@ struct ForceContext {
     double dt;         ///< [s]
     const Vec<D>* sv;  ///< mean velocities over the last step (StepMotion): they increment the springs [m/s]
     const Ang<D>* sw;  ///< [rad/s]
+    Vec<D>* planeForce = nullptr;         ///< null, or each plane contact's force on its particle [N]: [i nWalls + w]
+    SurfaceState<D>* surfaces = nullptr;  ///< null, or the walls of any shape with the particles' contacts
 };
 
 template <int D>
@@ -119,15 +123,18 @@ struct FinishViews {
     const Vec<D>* x;
     const std::uint8_t* flags;
     std::size_t nWalls;
+    bool surfaces;
     explicit FinishViews(const ForceContext<D>& ctx)
         : f(ctx.p.f.data()),
           torque(ctx.p.torque.data()),
           x(ctx.p.x.data()),
           flags(ctx.p.flags.data()),
-          nWalls(ctx.nWalls) {}
+          nWalls(ctx.nWalls),
+          surfaces(ctx.surfaces != nullptr) {}
 };
 
-/// Particle i's pair sums are complete: adds its wall contacts (in wall order; not for a frozen particle), stores
+/// Particle i's pair sums are complete: adds its wall contacts (planes in wall order, then the walls of any shape;
+/// not for a frozen particle), stores
 /// force and torque, then runs the caller's per-particle step then(i, f, torque).
 template <int D, class K, class Then>
 [[gnu::always_inline]] inline ParticleTally finishParticle(const FinishViews<D>& fv, const K& kernel, std::size_t i,
@@ -139,11 +146,12 @@ template <int D, class K, class Then>
     // A NaN anywhere reaches the force of its particle in the same step.
     bool finite;
     const std::size_t nw = fv.nWalls;
-    if (nw > 0 && !(fv.flags[i] & kFrozen)) {
+    if ((nw > 0 || fv.surfaces) && !(fv.flags[i] & kFrozen)) {
         Vec<D> f = storedVec(fk);
         Ang<D> tq = storedVec(tqk);
         const auto& walls = kernel.walls();
         for (std::size_t w = 0; w < nw; ++w) contacts += walls.add(i, w, f, tq, worst);
+        if (fv.surfaces) contacts += walls.addSurfaces(i, f, tq, worst);
         fv.f[i] = f;
         fv.torque[i] = tq;
         finite = allFinite(f + storedVec(xi));
@@ -431,6 +439,7 @@ double contactEnergy(const ForceContext<D>& ctx, const K& kernel) {
     for (std::size_t i = 0; i < ctx.p.tdmCount(); ++i) {
         for (std::uint32_t k = first[i]; k < first[i + 1]; ++k) e += kernel.energy(i, k);
         for (std::size_t w = 0; w < ctx.nWalls; ++w) e += walls.energy(i, w);
+        if (ctx.surfaces) e += walls.surfaceEnergy(i);
     }
     return e;
 }

@@ -9,6 +9,8 @@
 #include "core/particles.hpp"
 #include "geometry/domain.hpp"
 #include "tdm/pair_pass.hpp"
+#include "tdm/surface_kernel.hpp"
+#include "tdm/wall_law.hpp"
 
 namespace haet {
 
@@ -20,6 +22,7 @@ public:
         : walls_(ctx.walls),
           nw_(ctx.nWalls),
           history_(ctx.wallHistory),
+          planeForce_(ctx.planeForce),
           x_(ctx.p.x.data()),
           v_(ctx.p.v.data()),
           w_(ctx.p.w.data()),
@@ -30,9 +33,9 @@ public:
           material_(ctx.p.material.data()),
           table_(ctx.cs.table.data()),
           nMaterials_(ctx.cs.nMaterials),
-          time_(ctx.time),
           dt_(ctx.dt),
-          clip_(!ctx.cs.attraction) {}
+          clip_(!ctx.cs.attraction),
+          surfaces_(ctx) {}
 
     /// Adds wall w's contact with particle i to its force f and torque tq, and its overlap / radius to worst;
     /// returns whether they touch. Not touching, the contact's spring is cleared.
@@ -40,34 +43,30 @@ public:
         const Wall<D>& wall = walls_[w];
         Vec<D>& hist = history_[i * nw_ + w];
         const double ri = radius_[i];
-        const double delta = ri - wall.distance(x_[i], time_);
+        const double delta = ri - wall.distanceNow(x_[i]);
         if (delta <= 0) {
             if constexpr (Tangential::kHasHistory) hist = Vec<D>::zero();
+            if (planeForce_) planeForce_[i * nw_ + w] = Vec<D>::zero();
             return false;
         }
-        const Vec<D>& nrm = wall.normal;
-        const double meff = mass_[i];
-        const Vec<D> dv = v_[i] - wall.velocity;
-        const double gn = dot(dv, nrm);
-        const PairCoeffs& c = table_[material_[i] * nMaterials_ + wall.material];
-        NormalResult nr = Normal::eval(c, delta, -gn, meff, ri);
-        if (clip_ && nr.fn < 0) nr.fn = 0;
-        f += nrm * nr.fn;
-        if constexpr (Tangential::kHasHistory) {
-            const Vec<D> gt = dv - nrm * gn - cross(w_[i] * ri, nrm);
-            const Vec<D> gs = sv_[i] - wall.velocity - cross(sw_[i] * ri, nrm);
-            const Vec<D> ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, hist, dt_);
-            f += ft;
-            tq += cross(nrm, ft) * (-ri);
-        }
+        const Vec<D> fw = wallContactLaw<D, Normal, Tangential>(table_[material_[i] * nMaterials_ + wall.material],
+                                                                delta, wall.normal, wall.velocityNow, v_[i], w_[i],
+                                                                sv_[i], sw_[i], ri, mass_[i], clip_, hist, dt_, f, tq);
+        if (planeForce_) planeForce_[i * nw_ + w] = fw;
         worst = std::max(worst, delta / ri);
         return true;
     }
 
+    /// Adds particle i's contacts with walls of any shape (tdm/surface_kernel.hpp); returns how many touch.
+    [[gnu::always_inline]] std::uint32_t addSurfaces(std::size_t i, Vec<D>& f, Ang<D>& tq, double& worst) const {
+        return surfaces_.add(i, f, tq, worst);
+    }
+    double surfaceEnergy(std::size_t i) const { return surfaces_.energy(i); }
+
     /// Elastic energy of wall w's contact with particle i at the current state [J] (the law's).
     double energy(std::size_t i, std::size_t w) const {
         const Wall<D>& wall = walls_[w];
-        const double delta = radius_[i] - wall.distance(x_[i], time_);
+        const double delta = radius_[i] - wall.distanceNow(x_[i]);
         if (delta <= 0) return 0;
         return Normal::energy(table_[material_[i] * nMaterials_ + wall.material], delta, mass_[i], radius_[i]);
     }
@@ -76,6 +75,7 @@ private:
     const Wall<D>* walls_;
     std::size_t nw_;
     Vec<D>* history_;
+    Vec<D>* planeForce_;  ///< null, or the force of each (particle, wall) contact [N] (named walls' loads)
     const Vec<D>* x_;
     const Vec<D>* v_;
     const Ang<D>* w_;
@@ -86,8 +86,9 @@ private:
     const std::uint16_t* material_;
     const PairCoeffs* table_;
     int nMaterials_;
-    double time_, dt_;
+    double dt_;
     bool clip_;
+    SurfaceKernel<D, Normal, Tangential> surfaces_;
 };
 
 }  // namespace haet

@@ -6,6 +6,7 @@
 
 #include "core/rng.hpp"
 #include "scenario/insert.hpp"
+#include "scenario/walls.hpp"
 
 namespace haet {
 
@@ -52,14 +53,15 @@ World<D> buildWorld(const Scenario& sc) {
     w.domain.hi = toVec<D>(sc.domain.hi);
     w.domain.gravity = toVec<D>(sc.domain.gravity);
     for (int k = 0; k < D; ++k) w.domain.periodic[k] = sc.domain.periodic[k];
-    for (const WallDef& wd : sc.walls) {
-        Wall<D> wall;
-        wall.point = toVec<D>(wd.point);
-        wall.normal = toVec<D>(wd.normal);
-        wall.normal *= 1.0 / norm(wall.normal);
-        wall.velocity = toVec<D>(wd.velocity);
-        wall.material = wd.material;
-        w.walls.push_back(wall);
+    for (std::size_t q = 0; q < sc.walls.size(); ++q) {
+        const WallDef& wd = sc.walls[q];
+        if (wd.isPlane()) {
+            w.walls.push_back(makePlane<D>(wd));
+            w.walls.back().id = static_cast<int>(q);
+        } else {
+            w.surfaces.push_back(makeSurfaceWall<D>(wd));
+            w.surfaces.back().id = static_cast<int>(q);
+        }
     }
     insertParticles<D>(sc, w.particles, Rng(sc.seed, RngStream::Insert));
     w.contact = buildContactSetup<D>(sc, materialStats(w.particles, static_cast<int>(sc.materials.size())));
@@ -78,6 +80,7 @@ TdmSettings tdmSettings(const Scenario& sc, const World<D>& w, std::string* dtNo
     if (polygons > 0 && !sc.tdm.integratorGiven) s.integrator = IntegratorKind::Gear5;
     s.maxOverlap = sc.tdm.maxOverlap;
     s.sortEvery = sc.tdm.sortEvery;
+    for (const WallDef& wd : sc.walls) s.planeLoads = s.planeLoads || (wd.isPlane() && !wd.name.empty());
     std::ostringstream note;
     if (sc.tdm.dt) {
         s.dt = *sc.tdm.dt;

@@ -7,6 +7,7 @@
 #include "contact/setup.hpp"
 #include "core/particles.hpp"
 #include "geometry/domain.hpp"
+#include "geometry/surface.hpp"
 
 namespace haet {
 
@@ -14,7 +15,8 @@ template <int D>
 struct World {
     Particles<D> particles;
     Domain<D> domain;
-    std::vector<Wall<D>> walls;
+    std::vector<Wall<D>> walls;            ///< planes
+    std::vector<SurfaceWall<D>> surfaces;  ///< walls of any other shape (geometry/surface.hpp)
     ContactSetup contact;
     double time = 0;  ///< simulated time [s]
 };

@@ -103,8 +103,9 @@ TEST(EdmValidate, MatchesReferenceLongRun) {
     World<3> w = testing::makeGas<3>(g, testing::edmContact(0.9, 0.3, 0.5));
     w.domain.periodic[2] = false;
     const double L = w.domain.hi[2];
-    w.walls.push_back({Vec<3>::zero(), Vec<3>{{0, 0, 1}}, Vec<3>::zero(), 0});
-    w.walls.push_back({Vec<3>::filled(L), Vec<3>{{0, 0, -1}}, Vec<3>{{0, 0, -0.01}}, 0});  // a slowly moving lid
+    w.walls.push_back(Wall<3>::plane(Vec<3>::zero(), Vec<3>{{0, 0, 1}}, Vec<3>::zero(), 0));
+    w.walls.push_back(
+        Wall<3>::plane(Vec<3>::filled(L), Vec<3>{{0, 0, -1}}, Vec<3>{{0, 0, -0.01}}, 0));  // a slowly moving lid
     EdmSettings s;
     s.tcTime = 1e-3;
     auto run = [&](bool reference, double shell, std::vector<EdmCollision<3>>& log) {

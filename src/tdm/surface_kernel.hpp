@@ -1,0 +1,152 @@
+#pragma once
+// The wall kernel of disks and spheres against walls of any shape (geometry/surface.hpp): the particle's
+// candidates from the broad phase, their contacts (docs/physics.md H.2: local minima of the distance, each wall's
+// merged), each matched to the particle's contact with that wall in the last pass (its spring carries over,
+// H.3), then the particles' contact law as for a plane (wallContactLaw, tdm/wall_law.hpp), with the wall's
+// surface velocity at the contact point. The pair pass (tdm/pair_pass.hpp) runs it once the particle's pair and
+// plane sums are complete.
+#include <algorithm>
+#include <cstdint>
+
+#include "contact/laws.hpp"
+#include "contact/setup.hpp"
+#include "core/particles.hpp"
+#include "tdm/pair_pass.hpp"
+#include "tdm/surface_state.hpp"
+#include "tdm/wall_law.hpp"
+
+namespace haet {
+
+template <int D, class Normal, class Tangential>
+class SurfaceKernel {
+public:
+    /// Contacts of one particle found in one pass, before merging: at most this many are kept.
+    static constexpr int kMaxHits = 32;
+
+    explicit SurfaceKernel(const ForceContext<D>& ctx)
+        : s_(ctx.surfaces),
+          x_(ctx.p.x.data()),
+          v_(ctx.p.v.data()),
+          w_(ctx.p.w.data()),
+          sv_(ctx.sv),
+          sw_(ctx.sw),
+          radius_(ctx.p.radius.data()),
+          mass_(ctx.p.mass.data()),
+          material_(ctx.p.material.data()),
+          table_(ctx.cs.table.data()),
+          nMaterials_(ctx.cs.nMaterials),
+          dt_(ctx.dt),
+          clip_(!ctx.cs.attraction) {}
+
+    /// Adds particle i's contacts with walls of any shape to its force f and torque tq, and their overlap / radius to
+    /// worst; returns how many touch.
+    std::uint32_t add(std::size_t i, Vec<D>& f, Ang<D>& tq, double& worst) const {
+        SurfaceState<D>& s = *s_;
+        const std::uint32_t base = s.slotOf[i];
+        if (base == SurfaceState<D>::kNoSlots) return 0;
+        const std::vector<SurfaceWall<D>>& walls = *s.walls;
+        const double ri = radius_[i];
+        const Vec<D> xi = x_[i];
+        SurfaceHit<D> hits[kMaxHits];
+        std::uint32_t hitWall[kMaxHits];
+        int nh = 0;
+        const std::uint32_t k1 = s.candidates.first[i + 1];
+        for (std::uint32_t k = s.candidates.first[i]; k < k1;) {
+            // One wall's candidates at a time: its contacts are merged among themselves.
+            const std::uint32_t w = s.candidates.wall[k];
+            const Vec<D> xb = s.poses[w].toBody(xi);
+            const int start = nh;
+            for (; k < k1 && s.candidates.wall[k] == w; ++k)
+                walls[w].contacts(s.candidates.element[k], xb, ri, [&](const SurfaceHit<D>& h) {
+                    if (nh < kMaxHits) hits[nh++] = h;
+                });
+            nh = start + mergeHits(hits + start, nh - start);
+            for (int q = start; q < nh; ++q) hitWall[q] = w;
+        }
+        if (nh > kSurfaceSlots) {  // the deepest, in their order otherwise
+            int order[kMaxHits];
+            for (int q = 0; q < nh; ++q) order[q] = q;
+            std::stable_sort(order, order + nh, [&](int a, int b) { return hits[a].distance < hits[b].distance; });
+            std::sort(order, order + kSurfaceSlots);
+            for (int q = 0; q < kSurfaceSlots; ++q) {
+                hits[q] = hits[order[q]];
+                hitWall[q] = hitWall[order[q]];
+            }
+            nh = kSurfaceSlots;
+        }
+
+        SurfaceContact<D>* slot = s.slots.data() + base;
+        const int old = s.count[i];
+        SurfaceContact<D> now[kSurfaceSlots];
+        bool taken[kSurfaceSlots] = {};
+        for (int q = 0; q < nh; ++q) {
+            const std::uint32_t w = hitWall[q];
+            const Pose<D>& pose = s.poses[w];
+            SurfaceContact<D>& c = now[q];
+            c.wall = w;
+            c.normal = pose.directionToWorld(hits[q].normal);
+            c.point = pose.toWorld(hits[q].point);
+            c.overlap = ri - hits[q].distance;
+            // The same contact as in the last pass: the wall's contact with the nearest normal.
+            int match = -1;
+            double best = 0.5;
+            for (int o = 0; o < old; ++o) {
+                if (taken[o] || slot[o].wall != w) continue;
+                const double d = dot(slot[o].normal, c.normal);
+                if (d > best) {
+                    best = d;
+                    match = o;
+                }
+            }
+            if (match >= 0) {
+                taken[match] = true;
+                c.spring = slot[match].spring;
+            } else {
+                c.spring = Vec<D>::zero();
+            }
+        }
+        for (int q = 0; q < nh; ++q) {
+            SurfaceContact<D>& c = now[q];
+            const SurfaceWall<D>& wall = walls[c.wall];
+            c.force =
+                wallContactLaw<D, Normal, Tangential>(table_[material_[i] * nMaterials_ + wall.material], c.overlap,
+                                                      c.normal, s.poses[c.wall].surfaceVelocity(c.point), v_[i], w_[i],
+                                                      sv_[i], sw_[i], ri, mass_[i], clip_, c.spring, dt_, f, tq);
+            worst = std::max(worst, c.overlap / ri);
+            slot[q] = c;
+        }
+        s.count[i] = static_cast<std::uint8_t>(nh);
+        return static_cast<std::uint32_t>(nh);
+    }
+
+    /// The elastic energy of particle i's contacts with walls of any shape at the last force pass [J].
+    double energy(std::size_t i) const {
+        const SurfaceState<D>& s = *s_;
+        const std::uint32_t base = s.slotOf[i];
+        if (base == SurfaceState<D>::kNoSlots) return 0;
+        double e = 0;
+        for (int q = 0; q < s.count[i]; ++q) {
+            const SurfaceContact<D>& c = s.slots[base + q];
+            e += Normal::energy(table_[material_[i] * nMaterials_ + (*s.walls)[c.wall].material], c.overlap, mass_[i],
+                                radius_[i]);
+        }
+        return e;
+    }
+
+private:
+    SurfaceState<D>* s_;
+    const Vec<D>* x_;
+    const Vec<D>* v_;
+    const Ang<D>* w_;
+    const Vec<D>* sv_;
+    const Ang<D>* sw_;
+    const double* radius_;
+    const double* mass_;
+    const std::uint16_t* material_;
+    const PairCoeffs* table_;
+    int nMaterials_;
+    double dt_;
+    bool clip_;
+};
+
+}  // namespace haet

@@ -1,0 +1,45 @@
+#pragma once
+// What the time-driven engine keeps of the contacts of particles with walls of any shape (geometry/surface.hpp):
+// the walls' poses at the current time, the broad phase's candidates (neighbor/surface_list.hpp) and each
+// particle's contacts. A contact belongs to the particle and the wall, not to an element: from one step to the
+// next it is found again by its normal (the old contact of the same wall whose normal is nearest the new one,
+// within 60 degrees), so its tangential spring survives the step from one triangle or segment to the next
+// (docs/physics.md H.3). Only particles with candidates hold slots, so a scene's memory grows with the particles
+// near its walls, not with all of them.
+#include <cstdint>
+#include <vector>
+
+#include "geometry/surface.hpp"
+#include "neighbor/surface_list.hpp"
+
+namespace haet {
+
+/// Contacts of one particle with walls of any shape, at most (more: the deepest are kept).
+inline constexpr int kSurfaceSlots = 4;
+
+template <int D>
+struct SurfaceContact {
+    Vec<D> normal;           ///< unit normal from the wall to the centre (world) [-]
+    Vec<D> spring;           ///< tangential spring elongation [m]
+    Vec<D> force;            ///< the contact's force on the particle at the last force pass [N]
+    Vec<D> point;            ///< contact point on the wall (world) [m]
+    double overlap = 0;      ///< radius - distance [m]
+    std::uint32_t wall = 0;  ///< index into the surface walls
+};
+
+template <int D>
+struct SurfaceState {
+    static constexpr std::uint32_t kNoSlots = 0xFFFFFFFFu;
+    const std::vector<SurfaceWall<D>>* walls = nullptr;
+    std::vector<Pose<D>> poses;    ///< each wall's pose at the time of the current force pass
+    SurfaceCandidates candidates;  ///< built at candidatesTime
+    double candidatesTime = 0;     ///< [s]
+    /// Particle i's contacts: slots[slotOf[i] ... + count[i]) (kSurfaceSlots reserved), kNoSlots without candidates.
+    std::vector<std::uint32_t> slotOf;
+    std::vector<std::uint8_t> count;
+    std::vector<SurfaceContact<D>> slots;
+
+    bool empty() const { return walls == nullptr || walls->empty(); }
+};
+
+}  // namespace haet
