@@ -95,7 +95,7 @@ TEST_F(Stl, BinaryThatStartsWithSolid) {
     // Many exporters write "solid NAME" into the binary header; the size 84 + 50 n decides.
     const auto tris = randomTriangles(5, true);
     for (const std::string& header : {std::string("solid part"), std::string("solid"),
-                                     "  SOLID x  with text, padded with spaces" + std::string(50, ' ')}) {
+                                      "  SOLID x  with text, padded with spaces" + std::string(50, ' ')}) {
         const StlMesh m = readStl(write("s.stl", stlBinary(tris, header)));
         EXPECT_TRUE(m.binary) << header;
         ASSERT_EQ(m.triangles.size(), 5u);
