@@ -11,7 +11,8 @@
 // side its normal points to), which the readers keep.
 //
 // Which format: a file whose size is 84 + 50 n for the count n at byte 80 is binary, even if it starts with
-// "solid" (many exporters write that into the binary header). Otherwise a file that starts with "solid" and has no
+// "solid" (many exporters write that into the binary header; an ASCII file cannot match by chance below 7 GB, as its
+// bytes 80-83 are text, a count of at least 0x09090909). Otherwise a file that starts with "solid" and has no
 // control byte (NUL and the like; ASCII STL is text) in its first 84 bytes is ASCII; anything else is binary, and
 // then its size is wrong: truncated or with trailing bytes.
 #include <array>
