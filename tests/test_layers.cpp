@@ -15,10 +15,11 @@ namespace fs = std::filesystem;
 
 /// Layer of a project header or source, by its path below src/ ("tdm/engine.hpp"). World's state
 /// (world/world.hpp) sits below the engines that share it; building a world from definitions sits above them.
+/// io/ sits just above core/: a file format may hold core's vectors (an STL mesh's triangles), nothing else.
 int layerOf(const std::string& path) {
     if (path == "world/world.hpp") return 3;
     static const std::map<std::string, int> kLayers = {
-        {"core", 0},    {"io", 0},   {"geometry", 1}, {"contact", 2}, {"neighbor", 3}, {"tdm", 4},  {"edm", 4},
+        {"core", 0},    {"io", 1},   {"geometry", 1}, {"contact", 2}, {"neighbor", 3}, {"tdm", 4},  {"edm", 4},
         {"polygon", 5}, {"haet", 6}, {"scenario", 7}, {"world", 8},   {"run", 9},      {"app", 10},
     };
     const auto it = kLayers.find(path.substr(0, path.find('/')));

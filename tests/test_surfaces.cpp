@@ -6,10 +6,12 @@
 
 #include <cmath>
 #include <random>
+#include <sstream>
 
 #include "geometry/closest.hpp"
 #include "geometry/surface.hpp"
 #include "neighbor/surface_list.hpp"
+#include "run/runner.hpp"
 #include "scenario/loader.hpp"
 #include "tdm/engine.hpp"
 #include "world_util.hpp"
@@ -408,9 +410,29 @@ TEST(SurfaceInput, BadGeometryNamesTheKey) {
                     "method = \"tdm\"");
     expectWallError(scene(2, "tdm", "type = \"arc\"\ncenter = [0.5, 0.5]\nradius = 0.4\nangles = [90, 10]\n"),
                     "walls[1].angles", "from < to");
+    expectWallError(scene(3, "tdm", "type = \"mesh\"\nfile = \"no_such.stl\"\n"), "walls[1].file", "no_such.stl");
+    expectWallError(scene(3, "tdm", "type = \"disc\"\ncenter = [5, 5, 5]\nnormal = [0, 0, 1]\nradius = 0.1\n"),
+                    "walls[1].type", "entirely outside the domain");
     // A huge normal is a direction, not an overflow.
     const Scenario ok = parseScenario(scene(2, "tdm", "point = [0, 0]\nnormal = [1e200, 1e200]\n"), "walls.toml");
     EXPECT_NEAR(ok.walls[0].normal[0], std::sqrt(0.5), 1e-15);
+}
+
+TEST(SurfaceInput, WallExamplesCheck) {
+    // The scenes with walls of every kind load (meshes from their STL files) and `haet check` lists the walls.
+    for (const char* name : {"hopper2d.toml", "silo3d.toml", "drum3d.toml", "mixer3d.toml"}) {
+        const Scenario sc = loadScenario(std::string(HAET_SOURCE_DIR) + "/examples/" + name);
+        std::ostringstream out;
+        describeScenario(sc, out);
+        EXPECT_NE(out.str().find("wall       1"), std::string::npos) << name << "\n" << out.str();
+    }
+    const Scenario silo = loadScenario(std::string(HAET_SOURCE_DIR) + "/examples/silo3d.toml");
+    EXPECT_EQ(silo.walls[1].triangles.size(), 512u);
+    EXPECT_NEAR(silo.walls[1].triangles[0][0][2], 0.016, 0.061);  // moved onto the hopper
+    double zmin = 1;
+    for (const auto& t : silo.walls[1].triangles)
+        for (const auto& p : t) zmin = std::min(zmin, p[2]);
+    EXPECT_NEAR(zmin, 0.016, 1e-9);
 }
 
 }  // namespace

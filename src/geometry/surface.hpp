@@ -86,12 +86,14 @@ struct SurfaceWall {
             }
             return;
         }
-        if (kind == SurfaceKind::Cylinder) {
+        // A circle of radius r about the unit axis a reaches r sqrt(1 - a_k^2) along coordinate k.
+        if (kind == SurfaceKind::Cylinder || kind == SurfaceKind::Disc) {
             const double r = std::max(radius, radius1);
-            const Vec<D> top = centre + axis * length;
+            const Vec<D> top = centre + axis * (kind == SurfaceKind::Cylinder ? length : 0.0);
             for (int a = 0; a < D; ++a) {
-                lo[a] = std::min(centre[a], top[a]) - r;
-                hi[a] = std::max(centre[a], top[a]) + r;
+                const double reach = r * std::sqrt(std::max(0.0, 1 - axis[a] * axis[a]));
+                lo[a] = std::min(centre[a], top[a]) - reach;
+                hi[a] = std::max(centre[a], top[a]) + reach;
             }
             return;
         }

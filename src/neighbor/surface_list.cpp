@@ -48,13 +48,17 @@ void buildSurfaceCandidates(const Particles<D>& p, std::size_t n, const Domain<D
     const double cap = std::min(4.0 * static_cast<double>(n) + 64.0, 4194304.0);
     double edge = 2 * reach;
     for (;;) {
-        const auto dims = CellGrid<D>::spanningDims(dom.lo, dom.hi, edge, true);
+        const auto dims =
+            CellGrid<D>::spanningDims(dom.lo - Vec<D>::filled(edge), dom.hi + Vec<D>::filled(edge), edge, true);
         double cells = 1;
         for (int k = 0; k < D; ++k) cells *= dims[k];
         if (cells <= cap) break;
         edge *= 1.5;
     }
-    const CellGrid<D> grid = CellGrid<D>::spanning(dom.lo, dom.hi, edge, std::array<bool, D>{}, true);
+    // One layer of cells beyond the box on every side: points beyond it (clamped into the outer layer) are few,
+    // so only the outer layer goes without the distance refinement below.
+    const CellGrid<D> grid = CellGrid<D>::spanning(dom.lo - Vec<D>::filled(edge), dom.hi + Vec<D>::filled(edge), edge,
+                                                   std::array<bool, D>{}, true);
     double half2 = 0;
     for (int k = 0; k < D; ++k) half2 += 0.25 * grid.width()[k] * grid.width()[k];
     const double half = std::sqrt(half2);

@@ -191,8 +191,8 @@ void appendWallLoads(const World<D>& w, const TdmEngine<D>& eng, std::vector<std
 template <int D>
 void describeWalls(const World<D>& w, std::ostream& out) {
     auto label = [](const std::string& name) { return name.empty() ? std::string() : " \"" + name + "\""; };
-    for (std::size_t q = 0; q < w.walls.size(); ++q) {
-        const Wall<D>& wl = w.walls[q];
+    // In file order: planes and the other walls are kept apart, each knows its place (id).
+    auto plane = [&](const Wall<D>& wl) {
         std::string pt, n;
         for (int k = 0; k < D; ++k) {
             pt += fmt::format("{}{:.4g}", k ? ", " : "", wl.point[k]);
@@ -203,9 +203,8 @@ void describeWalls(const World<D>& w, std::ostream& out) {
         if (wl.oscillates()) motion += fmt::format(", oscillating {:.4g} Hz", wl.frequency);
         out << fmt::format("wall       {}{}: plane through [{}], normal [{}]{}\n", wl.id + 1, label(wl.name), pt, n,
                            motion);
-    }
-    for (std::size_t q = 0; q < w.surfaces.size(); ++q) {
-        const SurfaceWall<D>& s = w.surfaces[q];
+    };
+    auto surface = [&](const SurfaceWall<D>& s) {
         Vec<D> lo, hi;
         for (std::size_t e = 0; e < s.elementCount(); ++e) {
             Vec<D> a, b;
@@ -240,6 +239,13 @@ void describeWalls(const World<D>& w, std::ostream& out) {
                 break;
         }
         out << fmt::format("wall       {}{}: {}, box {}{}\n", s.id + 1, label(s.name), kind, box, motionText(s.motion));
+    };
+    std::size_t a = 0, b = 0;
+    while (a < w.walls.size() || b < w.surfaces.size()) {
+        if (b == w.surfaces.size() || (a < w.walls.size() && w.walls[a].id < w.surfaces[b].id))
+            plane(w.walls[a++]);
+        else
+            surface(w.surfaces[b++]);
     }
 }
 

@@ -4,6 +4,8 @@
 #include <numbers>
 #include <string>
 
+#include "io/stl.hpp"
+
 namespace haet {
 
 namespace {
@@ -90,6 +92,47 @@ void readInlineMesh(const TableReader& r, WallDef& w) {
     }
 }
 
+/// Mesh from an STL file, placed by scale, rotate and translate (io/stl.hpp: p' = R (S p) + T).
+void readStlMesh(const TableReader& r, const std::filesystem::path& dir, WallDef& w) {
+    const std::string file = r.requiredString("file");
+    std::filesystem::path path(file);
+    if (path.is_relative() && !r.fromOverride("file")) path = dir / path;
+    StlTransform t;
+    if (r.has("scale")) {
+        const toml::node* n = r.table().get("scale");
+        if (n->is_array()) {
+            const Vec3d sc = r.requiredVector("scale", 3);
+            t.scale = Vec<3>{{sc[0], sc[1], sc[2]}};
+        } else {
+            t.scale = Vec<3>::filled(r.requiredNumber("scale"));
+        }
+        for (int k = 0; k < 3; ++k)
+            if (t.scale[k] == 0) r.fail("scale", "must be nonzero");
+    }
+    if (const toml::table* rt = r.subTable("rotate")) {
+        const TableReader o(*rt, r.keyPath("rotate"), r.file());
+        o.allowOnly({"axis", "angle"});
+        const Vec3d ax = unitVector(o, "axis", o.requiredVector("axis", 3));
+        t.axis = Vec<3>{{ax[0], ax[1], ax[2]}};
+        t.angle_deg = o.requiredNumber("angle");
+    }
+    if (const auto tr = r.vector("translate", 3)) t.translate = Vec<3>{{(*tr)[0], (*tr)[1], (*tr)[2]}};
+    try {
+        StlMesh mesh = readStl(path);
+        transformStl(mesh, t);
+        for (const StlTriangle& tri : mesh.triangles) {
+            std::array<Vec3d, 3> c;
+            for (int k = 0; k < 3; ++k) c[k] = {tri[k][0], tri[k][1], tri[k][2]};
+            w.triangles.push_back(c);
+        }
+    } catch (const StlError& e) {
+        r.fail("file", e.what());
+    } catch (const std::invalid_argument& e) {
+        r.fail("scale", e.what());
+    }
+    w.file = path.string();
+}
+
 void checkTriangles(const TableReader& r, std::string_view key, const WallDef& w) {
     for (std::size_t q = 0; q < w.triangles.size(); ++q) {
         const auto& t = w.triangles[q];
@@ -103,7 +146,7 @@ void checkTriangles(const TableReader& r, std::string_view key, const WallDef& w
 
 }  // namespace
 
-WallDef readWall(const TableReader& r, int dim, int material, const std::filesystem::path& /*dir*/) {
+WallDef readWall(const TableReader& r, int dim, int material, const std::filesystem::path& dir) {
     WallDef w;
     w.pos = r.tablePos();
     w.material = material;
@@ -237,14 +280,49 @@ WallDef readWall(const TableReader& r, int dim, int material, const std::filesys
             break;
         }
         case WallType::Mesh:
-            allow({"vertices", "triangles"});
-            if (!r.has("vertices")) r.fail("vertices", "is required (an array of [x, y, z] points)");
-            readInlineMesh(r, w);
-            checkTriangles(r, "triangles", w);
+            allow({"file", "scale", "rotate", "translate", "vertices", "triangles"});
+            if (r.has("file")) {
+                if (r.has("vertices")) r.fail("vertices", "give either file or vertices and triangles, not both");
+                readStlMesh(r, dir, w);
+            } else {
+                if (!r.has("vertices"))
+                    r.fail("file", "is required (an STL file), or vertices and triangles given in the scenario");
+                for (const char* k : {"scale", "rotate", "translate"})
+                    if (r.has(k)) r.fail(k, "applies to a mesh from a file");
+                readInlineMesh(r, w);
+                checkTriangles(r, "triangles", w);
+            }
             break;
     }
     return w;
 }
+
+namespace {
+
+/// A box that holds the wall at t = 0 (not a tight one for cylinders and cones) [m].
+void boundsOf(const WallDef& w, int dim, Vec3d& lo, Vec3d& hi) {
+    lo = {1e300, 1e300, 1e300};
+    hi = {-1e300, -1e300, -1e300};
+    auto take = [&](const Vec3d& p, double r) {
+        for (int k = 0; k < dim; ++k) {
+            lo[k] = std::min(lo[k], p[k] - r);
+            hi[k] = std::max(hi[k], p[k] + r);
+        }
+    };
+    for (const Vec3d& p : w.points) take(p, 0);
+    for (const auto& t : w.triangles)
+        for (const Vec3d& p : t) take(p, 0);
+    const double r = std::max(w.radius, w.radiusTop);
+    if (w.type == WallType::Circle || w.type == WallType::Arc || w.type == WallType::Disc) take(w.centre, r);
+    if (w.type == WallType::Cylinder || w.type == WallType::Cone) {
+        take(w.centre, r);
+        take({w.centre[0] + w.axis[0] * w.length, w.centre[1] + w.axis[1] * w.length,
+              w.centre[2] + w.axis[2] * w.length},
+             r);
+    }
+}
+
+}  // namespace
 
 void checkWalls(const Scenario& s) {
     bool polygons = false;
@@ -262,6 +340,21 @@ void checkWalls(const Scenario& s) {
                                 "planes moving at a constant velocity)");
         if (!w.isPlane() && polygons)
             throw ScenarioError(w.pos, key + ".type", "polygon particles touch planes only: use plane walls");
+        const bool moves = w.rotates() || w.frequency != 0 || norm3(w.velocity) > 0;
+        if (!w.isPlane() && !moves) {
+            Vec3d lo, hi;
+            boundsOf(w, s.dimension, lo, hi);
+            bool apart = false;
+            for (int k = 0; k < s.dimension; ++k) apart = apart || hi[k] < s.domain.lo[k] || lo[k] > s.domain.hi[k];
+            if (apart) {
+                std::string box;
+                for (int k = 0; k < s.dimension; ++k)
+                    box += (k ? " x [" : "[") + formatNumber(lo[k]) + ", " + formatNumber(hi[k]) + "]";
+                throw ScenarioError(w.pos, key + (w.file.empty() ? ".type" : ".file"),
+                                    "the wall lies entirely outside the domain (its box " + box +
+                                        "); move it with translate, or fix the domain");
+            }
+        }
     }
 }
 

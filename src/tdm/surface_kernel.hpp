@@ -17,6 +17,16 @@
 
 namespace haet {
 
+/// N values of T, not initialised: the kernel's scratch per particle (zeroing it would cost more than its use).
+template <class T, int N>
+struct Scratch {
+    union {
+        T v[N];
+    };
+    Scratch() {}
+    T& operator[](int k) { return v[k]; }
+};
+
 template <int D, class Normal, class Tangential>
 class SurfaceKernel {
 public:
@@ -47,7 +57,7 @@ public:
         const std::vector<SurfaceWall<D>>& walls = *s.walls;
         const double ri = radius_[i];
         const Vec<D> xi = x_[i];
-        SurfaceHit<D> hits[kMaxHits];
+        Scratch<SurfaceHit<D>, kMaxHits> hits;
         std::uint32_t hitWall[kMaxHits];
         int nh = 0;
         const std::uint32_t k1 = s.candidates.first[i + 1];
@@ -60,7 +70,7 @@ public:
                 walls[w].contacts(s.candidates.element[k], xb, ri, [&](const SurfaceHit<D>& h) {
                     if (nh < kMaxHits) hits[nh++] = h;
                 });
-            nh = start + mergeHits(hits + start, nh - start);
+            nh = start + mergeHits(hits.v + start, nh - start);
             for (int q = start; q < nh; ++q) hitWall[q] = w;
         }
         if (nh > kSurfaceSlots) {  // the deepest, in their order otherwise
@@ -77,7 +87,7 @@ public:
 
         SurfaceContact<D>* slot = s.slots.data() + base;
         const int old = s.count[i];
-        SurfaceContact<D> now[kSurfaceSlots];
+        Scratch<SurfaceContact<D>, kSurfaceSlots> now;
         bool taken[kSurfaceSlots] = {};
         for (int q = 0; q < nh; ++q) {
             const std::uint32_t w = hitWall[q];
