@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
 #include <sstream>
 
@@ -151,6 +152,50 @@ TEST(SurfaceContact, CylinderInsideAndCorner) {
     const auto outside = hitsOf(c, v3(1.05, 0, -0.05), 0.1);  // beyond the rim, outside: the rim once
     ASSERT_EQ(outside.size(), 1u);
     EXPECT_NEAR(outside[0].distance, 0.05 * std::sqrt(2.0), 1e-14);
+}
+
+/// The total overlap of a ball of radius a at x with a wall: what its normal force grows with.
+template <int D>
+double overlapAt(const SurfaceWall<D>& w, const Vec<D>& x, double a) {
+    double s = 0;
+    for (const SurfaceHit<D>& h : hitsOf(w, x, a)) s += a - h.distance;
+    return s;
+}
+
+TEST(SurfaceContact, ForceContinuousAcrossEdgesAndVertices) {
+    // A ball resting on a convex ridge (two faces 20 degrees apart), on a flat mesh across an edge and over a vertex,
+    // and on a concave fold: moved across in small steps, its overlap changes by at most a few times the step (no
+    // jump where the contact passes from a face to an edge, a vertex or the next face).
+    const double a = 0.01, t = std::tan(10 * kPi / 180);
+    SurfaceWall<3> ridge, fold;
+    buildMesh<3>(ridge, {{v3(-1, -1, -t), v3(0, -1, 0), v3(0, 1, 0)},
+                         {v3(-1, -1, -t), v3(0, 1, 0), v3(-1, 1, -t)},
+                         {v3(0, -1, 0), v3(1, -1, -t), v3(1, 1, -t)},
+                         {v3(0, -1, 0), v3(1, 1, -t), v3(0, 1, 0)}});
+    buildMesh<3>(fold, {{v3(-1, -1, t), v3(0, -1, 0), v3(0, 1, 0)},
+                        {v3(-1, -1, t), v3(0, 1, 0), v3(-1, 1, t)},
+                        {v3(0, -1, 0), v3(1, -1, t), v3(1, 1, t)},
+                        {v3(0, -1, 0), v3(1, 1, t), v3(0, 1, 0)}});
+    const SurfaceWall<3> flat = flatMesh(1.0, 4, 0.0, 21);
+    const Vec<3> vtx = flat.vertices[7];  // an inner vertex of the flat mesh
+    struct Path {
+        const SurfaceWall<3>* w;
+        Vec<3> from, to;
+    };
+    const Path paths[] = {{&ridge, v3(-0.03, 0.1, 0.995 * a), v3(0.03, 0.1, 0.995 * a)},
+                          {&fold, v3(-0.03, 0.2, 0.995 * a), v3(0.03, 0.2, 0.995 * a)},
+                          {&flat, vtx + v3(-0.02, -0.013, 0.995 * a), vtx + v3(0.02, 0.017, 0.995 * a)}};
+    for (const Path& p : paths) {
+        const int n = 20000;
+        const double step = norm(p.to - p.from) / n;
+        double prev = overlapAt(*p.w, p.from, a), worst = 0;
+        for (int k = 1; k <= n; ++k) {
+            const double cur = overlapAt(*p.w, p.from + (p.to - p.from) * (double(k) / n), a);
+            worst = std::max(worst, std::abs(cur - prev) / step);
+            prev = cur;
+        }
+        EXPECT_LT(worst, 2.0) << "largest slope of the overlap along the path";
+    }
 }
 
 TEST(SurfaceList, CellsMatchBruteForce) {
@@ -413,6 +458,18 @@ TEST(SurfaceInput, BadGeometryNamesTheKey) {
     expectWallError(scene(3, "tdm", "type = \"mesh\"\nfile = \"no_such.stl\"\n"), "walls[1].file", "no_such.stl");
     expectWallError(scene(3, "tdm", "type = \"disc\"\ncenter = [5, 5, 5]\nnormal = [0, 0, 1]\nradius = 0.1\n"),
                     "walls[1].type", "entirely outside the domain");
+    {
+        // A truncated binary STL: its count says two triangles, the file holds one and a half.
+        const std::string path = ::testing::TempDir() + "truncated.stl";
+        std::ofstream f(path, std::ios::binary);
+        std::string bytes(80, ' ');
+        const std::uint32_t count = 2;
+        bytes.append(reinterpret_cast<const char*>(&count), 4);
+        bytes.append(75, '\0');
+        f << bytes;
+        f.close();
+        expectWallError(scene(3, "tdm", "type = \"mesh\"\nfile = \"" + path + "\"\n"), "walls[1].file", "truncated");
+    }
     // A huge normal is a direction, not an overflow.
     const Scenario ok = parseScenario(scene(2, "tdm", "point = [0, 0]\nnormal = [1e200, 1e200]\n"), "walls.toml");
     EXPECT_NEAR(ok.walls[0].normal[0], std::sqrt(0.5), 1e-15);
