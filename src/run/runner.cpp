@@ -22,6 +22,7 @@
 #include "io/series.hpp"
 #include "io/vtk.hpp"
 #include "polygon/output.hpp"
+#include "run/flow.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
 
@@ -658,7 +659,7 @@ void describeHaet(const Scenario& sc, std::ostream& out) {
         tdmReferences(sc, ts.integrator, false));
 }
 
-void describeScenario(const Scenario& sc, std::ostream& out) {
+static void describeMethod(const Scenario& sc, std::ostream& out) {
     if (sc.method == Method::Haet) {
         if (sc.dimension == 2)
             describeHaet<2>(sc, out);
@@ -677,6 +678,11 @@ void describeScenario(const Scenario& sc, std::ostream& out) {
         describeTdm<2>(sc, out);
     else
         describeTdm<3>(sc, out);
+}
+
+void describeScenario(const Scenario& sc, std::ostream& out) {
+    describeMethod(sc, out);
+    describeFlows(sc, out);
 }
 
 }  // namespace haet

@@ -13,214 +13,16 @@
 #include <utility>
 #include <vector>
 
+#include "scenario/flow_loader.hpp"
+#include "scenario/table_reader.hpp"
 #include "scenario/text.hpp"
 
 namespace haet {
 namespace {
 
-const char* const kAxisName[3] = {"x", "y", "z"};
-
-/// Reads the values of one TOML table and knows the dotted key path of each, so that every error names the key
-/// and the line it came from (the value's line, or the table's when the key is missing).
-class TableReader {
-public:
-    TableReader(const toml::table& table, std::string path, std::string file)
-        : table_(table), path_(std::move(path)), file_(std::move(file)) {}
-
-    const std::string& path() const { return path_; }
-    const std::string& file() const { return file_; }
-    const toml::table& table() const { return table_; }
-
-    std::string keyPath(std::string_view key) const {
-        return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
-    }
-    SourcePos tablePos() const { return posOfNode(table_); }
-    SourcePos posOf(std::string_view key) const {
-        if (const toml::node* n = table_.get(key)) return posOfNode(*n);
-        return tablePos();
-    }
-    /// Whether the value of `key` was given on the command line (`--set`), not in the file.
-    bool fromOverride(std::string_view key) const {
-        const toml::node* n = table_.get(key);
-        return n && n->source().path && *n->source().path != file_;
-    }
-    bool has(std::string_view key) const { return table_.contains(key); }
-
-    [[noreturn]] void fail(std::string_view key, const std::string& what) const {
-        throw ScenarioError(posOf(key), keyPath(key), what);
-    }
-    [[noreturn]] void failTable(const std::string& what) const { throw ScenarioError(tablePos(), path_, what); }
-
-    /// Rejects any key not in `allowed`; reports the first one in file order so the message is stable.
-    void allowOnly(std::initializer_list<std::string_view> allowed) const {
-        // An override's key comes first (its value holds the override's name), then the file's in line order.
-        const toml::key* first = nullptr;
-        auto before = [&](const toml::key& a, const toml::key& b) {
-            const bool oa = fromOverride(a.str()), ob = fromOverride(b.str());
-            return oa != ob ? oa : a.source().begin.line < b.source().begin.line;
-        };
-        for (auto&& [k, v] : table_) {
-            if (std::find(allowed.begin(), allowed.end(), std::string_view(k.str())) != allowed.end()) continue;
-            if (!first || before(k, *first)) first = &k;
-        }
-        if (first) {
-            const SourcePos pos =
-                fromOverride(first->str()) ? posOf(first->str()) : SourcePos{file_, int(first->source().begin.line)};
-            throw ScenarioError(pos, keyPath(first->str()), "unknown key");
-        }
-    }
-
-    /// Rejects `key` when present: it does not apply in this configuration (`why` says which one would need it).
-    void forbid(std::string_view key, const std::string& why) const {
-        if (has(key)) fail(key, why);
-    }
-
-    std::optional<double> number(std::string_view key) const {
-        const toml::node* n = table_.get(key);
-        if (!n) return std::nullopt;
-        const std::optional<double> v = asNumber(*n);
-        if (!v) fail(key, "expected a number");
-        if (!std::isfinite(*v)) fail(key, "must be finite");
-        return v;
-    }
-    double requiredNumber(std::string_view key) const {
-        const auto v = number(key);
-        if (!v) fail(key, "is required");
-        return *v;
-    }
-
-    std::optional<std::int64_t> integer(std::string_view key) const {
-        const toml::node* n = table_.get(key);
-        if (!n) return std::nullopt;
-        if (const auto* i = n->as_integer()) return i->get();
-        fail(key, "expected an integer");
-    }
-
-    std::optional<std::string> string(std::string_view key) const {
-        const toml::node* n = table_.get(key);
-        if (!n) return std::nullopt;
-        if (const auto* s = n->as_string()) return s->get();
-        fail(key, "expected a string");
-    }
-    std::string requiredString(std::string_view key) const {
-        auto s = string(key);
-        if (!s) fail(key, "is required");
-        return *s;
-    }
-
-    std::optional<bool> boolean(std::string_view key) const {
-        const toml::node* n = table_.get(key);
-        if (!n) return std::nullopt;
-        if (const auto* b = n->as_boolean()) return b->get();
-        fail(key, "expected a boolean (true or false)");
-    }
-
-    /// An array of exactly `dim` numbers; components beyond `dim` are zero.
-    std::optional<Vec3d> vector(std::string_view key, int dim) const {
-        const toml::node* n = table_.get(key);
-        if (!n) return std::nullopt;
-        const std::string expected = "expected an array of " + std::to_string(dim) + " numbers";
-        const toml::array* a = n->as_array();
-        if (!a || int(a->size()) != dim) fail(key, expected);
-        Vec3d out{0, 0, 0};
-        for (int k = 0; k < dim; ++k) {
-            const auto v = asNumber(*a->get(std::size_t(k)));
-            if (!v) fail(key, expected);
-            if (!std::isfinite(*v)) fail(key, "must be finite");
-            out[std::size_t(k)] = *v;
-        }
-        return out;
-    }
-    Vec3d requiredVector(std::string_view key, int dim) const {
-        auto v = vector(key, dim);
-        if (!v) fail(key, "is required");
-        return *v;
-    }
-
-    std::optional<std::array<bool, 3>> booleans(std::string_view key, int dim) const {
-        const toml::node* n = table_.get(key);
-        if (!n) return std::nullopt;
-        const std::string expected = "expected an array of " + std::to_string(dim) + " booleans";
-        const toml::array* a = n->as_array();
-        if (!a || int(a->size()) != dim) fail(key, expected);
-        std::array<bool, 3> out{false, false, false};
-        for (int k = 0; k < dim; ++k) {
-            const auto* b = a->get(std::size_t(k))->as_boolean();
-            if (!b) fail(key, expected);
-            out[std::size_t(k)] = b->get();
-        }
-        return out;
-    }
-
-    /// An array of integers, each at least `min`.
-    std::optional<std::vector<int>> integers(std::string_view key, int min) const {
-        const toml::node* n = table_.get(key);
-        if (!n) return std::nullopt;
-        const std::string expected = "expected an array of integers >= " + std::to_string(min);
-        const toml::array* a = n->as_array();
-        if (!a) fail(key, expected);
-        std::vector<int> out;
-        for (std::size_t k = 0; k < a->size(); ++k) {
-            const auto* v = a->get(k)->as_integer();
-            if (!v || v->get() < min || v->get() > 1000000) fail(key, expected);
-            out.push_back(static_cast<int>(v->get()));
-        }
-        return out;
-    }
-
-    /// A string that must be one of `options`; returns the matching value.
-    template <class E>
-    std::optional<E> choice(std::string_view key, std::initializer_list<std::pair<std::string_view, E>> options) const {
-        const auto s = string(key);
-        if (!s) return std::nullopt;
-        for (const auto& [name, value] : options)
-            if (*s == name) return value;
-        std::string list;
-        for (const auto& [name, value] : options) list += (list.empty() ? "" : ", ") + inQuotes(name);
-        fail(key, "must be one of " + list + " (got " + inQuotes(*s) + ")");
-    }
-
-    const toml::table* subTable(std::string_view key) const {
-        const toml::node* n = table_.get(key);
-        if (!n) return nullptr;
-        if (const auto* t = n->as_table()) return t;
-        fail(key, "expected a table");
-    }
-
-    /// An array whose every element is a table ([[key]] blocks, or an inline array of inline tables).
-    const toml::array* arrayOfTables(std::string_view key) const {
-        const toml::node* n = table_.get(key);
-        if (!n) return nullptr;
-        const toml::array* a = n->as_array();
-        if (!a || !a->is_array_of_tables()) fail(key, "expected an array of tables ([[" + std::string(key) + "]])");
-        return a;
-    }
-
-private:
-    /// A value of the file by its line; one set on the command line by the override that set it (its TOML source
-    /// is named "--set KEY=VALUE", applyOverride).
-    SourcePos posOfNode(const toml::node& n) const {
-        const auto& src = n.source();
-        if (src.path && *src.path != file_) return {file_ + " (" + *src.path + ")", 0};
-        return {file_, int(src.begin.line)};
-    }
-
-    static std::optional<double> asNumber(const toml::node& n) {
-        if (const auto* i = n.as_integer()) return double(i->get());
-        if (const auto* f = n.as_floating_point()) return f->get();
-        return std::nullopt;
-    }
-
-    const toml::table& table_;
-    std::string path_;
-    std::string file_;
-};
-
-/// Stand-in for an optional table that is absent, so its defaults are read through the same code.
-const toml::table& emptyTable() {
-    static const toml::table empty;
-    return empty;
-}
+using loader::emptyTable;
+using loader::kAxisName;
+using loader::TableReader;
 
 class Loader {
 public:
@@ -241,6 +43,7 @@ public:
         readHaet(s);
         readWalls(s);
         readInserts(s);
+        readFlows(s);
         checkDiskLaw(s);
         readOutput(s);
         return s;
@@ -399,6 +202,7 @@ private:
         if (!needDiskLaw_) return;
         bool disks = s.inserts.empty();
         for (const InsertDef& in : s.inserts) disks = disks || in.shape == ShapeKind::Disk;
+        for (const InletDef& in : s.inlets) disks = disks || in.particles.shape == ShapeKind::Disk;
         if (disks)
             child("contact").fail("duration", "the linear law needs a contact duration (or kn); neither is given");
     }
@@ -508,9 +312,44 @@ private:
         }
     }
 
+    /// [[outlet]] and [[inlet]] blocks (docs/scenario.md, "Outlets", "Inlets"): an inlet's particles are read as an
+    /// insert's (material, shape, sizes, region, velocities), its timing by loader::readInletFlow.
+    void readFlows(Scenario& s) const {
+        if (const toml::array* outlets = root_.arrayOfTables("outlet"))
+            for (std::size_t i = 0; i < outlets->size(); ++i)
+                s.outlets.push_back(loader::readOutlet(
+                    TableReader(*outlets->get(i)->as_table(), "outlet[" + std::to_string(i + 1) + "]", file_), dim_,
+                    s.duration));
+        const toml::array* inlets = root_.arrayOfTables("inlet");
+        for (std::size_t i = 0; inlets && i < inlets->size(); ++i) {
+            const TableReader r(*inlets->get(i)->as_table(), "inlet[" + std::to_string(i + 1) + "]", file_);
+            r.allowOnly({"name", "material", "region", "cylinder", "radius", "distribution", "velocity", "temperature",
+                         "rate", "mass_rate", "start", "end", "interval", "shape", "polygon", "sides", "aspect",
+                         "orientation"});
+            InletDef in;
+            InsertDef& p = in.particles;
+            p.material = materialIndex(r, "material");
+            readShape(r, p);
+            if (p.shape == ShapeKind::Polygon && s.method != Method::Tdm)
+                r.fail("shape", "polygons need method = \"tdm\" (the event-driven engine handles disks and spheres)");
+            loader::readSizes(r, dim_, p);
+            if (r.has("cylinder"))
+                loader::readCylinder(r, dim_, domain_, p);
+            else
+                readRegion(r, p);
+            p.velocity = r.vector("velocity", dim_).value_or(Vec3d{0, 0, 0});
+            p.temperature = r.number("temperature").value_or(0.0);
+            if (!(p.temperature >= 0)) r.fail("temperature", "must be >= 0");
+            loader::readInletFlow(r, dim_, s, in);
+            s.inlets.push_back(std::move(in));
+        }
+        loader::nameFlows(s);
+    }
+
     InsertDef readInsert(const TableReader& r) const {
-        r.allowOnly({"arrangement", "count", "radius", "material", "region", "spacing", "velocity", "temperature",
-                     "frozen", "file", "format", "frozen_types", "shape", "polygon", "sides", "aspect", "orientation"});
+        r.allowOnly({"arrangement", "count", "radius", "distribution", "material", "region", "spacing", "velocity",
+                     "temperature", "frozen", "file", "format", "frozen_types", "shape", "polygon", "sides", "aspect",
+                     "orientation"});
         InsertDef in;
         in.pos = r.tablePos();
         in.arrangement = r.choice<Arrangement>("arrangement", {{"random", Arrangement::Random},
@@ -525,7 +364,7 @@ private:
 
         if (in.arrangement == Arrangement::File) {
             const std::string why = "not used with arrangement = \"file\" (the file gives it per particle)";
-            for (const char* key : {"count", "radius", "region", "spacing", "velocity", "temperature"})
+            for (const char* key : {"count", "radius", "distribution", "region", "spacing", "velocity", "temperature"})
                 r.forbid(key, why);
             const std::string name = r.requiredString("file");
             if (name.empty()) r.fail("file", "must not be empty");
@@ -554,7 +393,7 @@ private:
         if (*count <= 0) r.fail("count", "must be > 0");
         in.count = std::size_t(*count);
 
-        readRadius(r, in);
+        loader::readSizes(r, dim_, in);
         readRegion(r, in);
 
         if (in.arrangement == Arrangement::Lattice) {
@@ -636,21 +475,6 @@ private:
             } else {
                 r.fail("orientation", "expected a number (radians) or \"random\"");
             }
-        }
-    }
-
-    void readRadius(const TableReader& r, InsertDef& in) const {
-        const toml::node* n = r.table().get("radius");
-        if (!n) r.fail("radius", "is required");
-        if (n->is_array()) {
-            const auto range = r.vector("radius", 2);  // "expected an array of 2 numbers" when malformed
-            in.radiusMin = (*range)[0];
-            in.radiusMax = (*range)[1];
-            if (!(in.radiusMin > 0 && in.radiusMin <= in.radiusMax)) r.fail("radius", "must satisfy 0 < min <= max");
-        } else {
-            if (!n->is_number()) r.fail("radius", "expected a number or an array [min, max] of 2 numbers");
-            in.radiusMin = in.radiusMax = *r.number("radius");
-            if (!(in.radiusMin > 0)) r.fail("radius", "must be > 0");
         }
     }
 
