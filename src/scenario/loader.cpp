@@ -31,7 +31,7 @@ public:
 
     Scenario load() {
         root_.allowOnly({"name", "dimension", "method", "duration", "seed", "domain", "materials", "contact", "tdm",
-                         "edm", "haet", "walls", "insert", "outlet", "output"});
+                         "edm", "haet", "walls", "insert", "outlet", "inlet", "output"});
         Scenario s;
         s.path = file_;
         readTop(s);
