@@ -154,6 +154,71 @@ TEST(Inlet, CylinderRegionHoldsItsNewborns) {
     EXPECT_EQ(born, 400u);
 }
 
+/// examples/pour3d.toml with its inlet's box replaced by a disc in the lid, crossed downwards at 0.5 m/s.
+std::string surfaceText() {
+    return replaced(sceneText("pour3d.toml"), "region = { lo = [0.005, 0.005, 0.06], hi = [0.025, 0.025, 0.08] }",
+                    "surface = { center = [0.015, 0.015, 0.08], normal = [0.0, 0.0, -1.0], radius = 0.008 }");
+}
+
+TEST(Inlet, SurfaceInletFillsTheSlabDownstreamOfItsFace) {
+    // As LIGGGHTS insert/stream: each batch fills the slab the flow crosses in one interval, 0.5 m/s x 0.016 s =
+    // 8 mm below the face (the default interval: a slab of four largest diameters).
+    const std::string text = surfaceText();
+    const Scenario sc = pour({"duration=0.032"}, text);
+    ASSERT_NEAR(sc.inlets[0].interval, 8 * 0.001 / 0.5, 1e-15);
+    World<3> w = buildWorld<3>(sc);
+    StaticHost<3> host(w);
+    const Flow<3> flow = runStatic(sc, w, host);
+    EXPECT_EQ(*flow.row()[0], 128);
+    for (std::size_t i = 0; i < w.particles.size(); ++i) {
+        if (w.particles.id[i] < 400) continue;
+        const Vec<3>& x = w.particles.x[i];
+        const double r = w.particles.radius[i];
+        EXPECT_LE(std::hypot(x[0] - 0.015, x[1] - 0.015), 0.008 - r + 1e-15);
+        EXPECT_GE(x[2], 0.072 + r - 1e-15);
+        EXPECT_LE(x[2], 0.08 - r + 1e-15);
+    }
+    // A face the velocity does not cross is bad input.
+    const std::string up = replaced(text, "velocity = [0.0, 0.0, -0.5]", "velocity = [0.0, 0.0, 0.5]");
+    try {
+        pour({}, up);
+        ADD_FAILURE() << "no error";
+    } catch (const ScenarioError& e) {
+        EXPECT_EQ(e.key(), "inlet[1].velocity") << e.what();
+        EXPECT_EQ(e.pos().line, lineOf(up, "velocity = [0.0, 0.0, 0.5]")) << e.what();
+    }
+}
+
+TEST(Inlet, SurfaceInletIn2DFillsTheStripBelowItsSegment) {
+    // examples/box2d_polygons.toml with a stream of hexagons through a 6 cm segment of its top, down at 0.5 m/s:
+    // the strip one interval thick (8 r_max / v = 0.032 s, 1.6 cm) below it.
+    const std::string inlet =
+        "[[inlet]]\nmaterial = \"grain\"\nshape = \"polygon\"\nsides = 6\nradius = [0.0015, 0.002]\nrate = 1000\n"
+        "velocity = [0.0, -0.5]\n"
+        "surface = { center = [0.05, 0.15], normal = [0.0, -1.0], length = 0.06 }\n\n[output]";
+    const std::string text = replaced(sceneText("box2d_polygons.toml"), "[output]", inlet);
+    const Scenario sc =
+        parseScenario(text, "box2d_polygons.toml", {"duration=0.032", "insert[2].count=20", "insert[1].count=50"});
+    World<2> w = buildWorld<2>(sc);
+    StaticHost<2> host(w);
+    Flow<2> flow(sc, w, 0.0);
+    for (double t = flow.nextTime(); t <= sc.duration; t = flow.nextTime()) {
+        w.time = t;
+        const std::size_t before = w.particles.size();
+        flow.act(w, host, 1e-12);
+        EXPECT_EQ(overlapsAtBirth(w, before), 0);
+        for (std::size_t i = before; i < w.particles.size(); ++i) {
+            const Vec<2>& x = w.particles.x[i];
+            const double r = w.particles.radius[i];
+            EXPECT_GE(x[0], 0.02 + r - 1e-15);
+            EXPECT_LE(x[0], 0.08 - r + 1e-15);
+            EXPECT_GE(x[1], 0.15 - 0.016 + r - 1e-15);
+            EXPECT_LE(x[1], 0.15 - r + 1e-15);
+        }
+    }
+    EXPECT_EQ(*flow.row()[0], 32);
+}
+
 TEST(Inlet, PolygonsWithTheInsertsShapeOptions) {
     // examples/box2d_polygons.toml with an inlet of random convex polygons at its top, turned at random.
     const std::string inlet =
@@ -319,6 +384,14 @@ TEST_F(FlowRun, CountsBalanceInEveryMethod) {
                                   "output.series_period=0.0025", "output.snapshot_period=-1"});
         expectBalanced(run(sc, m) / "series.csv", m);
     }
+    // A stream through a surface: the particles move on out of the slab, so the rate is met with no shortfall.
+    const fs::path out = run(pour({"duration=0.04", "output.snapshot_period=-1"}, surfaceText()), "surface");
+    const auto rows = readCsv(out / "series.csv");
+    const auto col = [&](const std::string& name) {
+        return std::size_t(std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin());
+    };
+    EXPECT_EQ(std::stod(rows.back()[col("feed_particles")]), 160);
+    EXPECT_EQ(std::stod(rows.back()[col("feed_shortfall")]), 0);
 }
 
 std::string fileText(const fs::path& p) {
@@ -403,7 +476,7 @@ TEST(Flows, CheckDescribesThePourScene) {
     std::ostringstream out;
     describeScenario(parseScenario(sceneText("pour3d.toml"), "pour3d.toml"), out);
     const std::string s = out.str();
-    EXPECT_NE(s.find("inlet      feed: 4000 particles/s from 0 s to 0.5 s"), std::string::npos) << s;
+    EXPECT_NE(s.find("inlet      feed: 4000 particles/s in a box from 0 s to 0.5 s"), std::string::npos) << s;
     EXPECT_NE(s.find("sizes      inlet feed: log-normal radius"), std::string::npos) << s;
     EXPECT_NE(s.find("outlet     drain: box"), std::string::npos) << s;
 }

@@ -120,9 +120,17 @@ struct InsertDef {
     bool cylinder = false;
     std::array<double, 2> cylinderCentre{0, 0};  ///< axis position (x, y) [m]
     double cylinderRadius = 0;                   ///< [m]
-    std::optional<double> spacing;               ///< lattice spacing [m]; default 2 * radius_max
-    Vec3d velocity{0, 0, 0};                     ///< mean velocity [m/s]
-    double temperature = 0;                      ///< velocity variance per component [m^2/s^2] (Maxwellian)
+    /// Surface inlets: the slab a batch fills, downstream of the face, instead of the box (then its bounding box):
+    /// centre, orthonormal axes (the last one the face's normal), half-extents along them; `slabRound`: a disc
+    /// face, radius slabHalf[0] about the last axis.
+    bool slab = false;
+    Vec3d slabCentre{0, 0, 0};        ///< [m]
+    std::array<Vec3d, 3> slabAxes{};  ///< unit vectors
+    Vec3d slabHalf{0, 0, 0};          ///< [m]
+    bool slabRound = false;
+    std::optional<double> spacing;  ///< lattice spacing [m]; default 2 * radius_max
+    Vec3d velocity{0, 0, 0};        ///< mean velocity [m/s]
+    double temperature = 0;         ///< velocity variance per component [m^2/s^2] (Maxwellian)
     bool frozen = false;
     std::string file;  ///< arrangement = File: path (resolved against the scenario dir)
     FileFormat format = FileFormat::Csv;

@@ -146,6 +146,86 @@ void readCylinder(const TableReader& r, int dim, const DomainDef& domain, Insert
         r.fail("cylinder", "narrower than one particle diameter");
 }
 
+void readSurface(const TableReader& r, int dim, const DomainDef& domain, InletDef& in) {
+    if (r.has("region") || r.has("cylinder")) r.fail("surface", "not together with region or cylinder (give one)");
+    InsertDef& p = in.particles;
+    const TableReader f(*r.subTable("surface"), r.keyPath("surface"), r.file());
+    f.allowOnly({"center", "normal", "size", "length", "radius", "axis"});
+    const Vec3d c = f.requiredVector("center", dim);
+    Vec3d n = f.requiredVector("normal", dim);
+    const double nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(nl > 0)) f.fail("normal", "must be nonzero");
+    for (double& x : n) x /= nl;
+    double vn = 0;
+    for (int k = 0; k < dim; ++k) vn += p.velocity[k] * n[k];
+    if (!(vn > 0))
+        r.fail(r.has("velocity") ? "velocity" : "surface",
+               "a surface inlet's velocity must cross its face (velocity . normal > 0)");
+    // Default: a slab of four largest diameters, so that each batch has room and leaves it before the next one.
+    if (!(in.interval > 0)) in.interval = std::min(8 * p.radiusMax / vn, in.end - in.start);
+    const double thick = vn * in.interval;  // how far the flow moves in one interval [m]
+    if (thick < 2 * p.radiusMax)
+        r.fail(r.has("interval") ? "interval" : "surface",
+               "the slab a batch fills, velocity . normal x interval = " + formatNumber(thick) +
+                   " m, is thinner than one particle diameter");
+    // In-plane axes: 2D the face's direction; 3D `axis` (the rectangle's first side, made normal to n) or any.
+    std::array<Vec3d, 3> axes{};
+    Vec3d half{0, 0, 0};
+    auto cross = [](const Vec3d& a, const Vec3d& b) {
+        return Vec3d{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    };
+    bool round = false;
+    if (dim == 2) {
+        for (const char* key : {"size", "radius", "axis"}) f.forbid(key, "not in 2D (a face is a segment: length)");
+        const double len = f.requiredNumber("length");
+        if (!(len > 0)) f.fail("length", "must be > 0");
+        axes[0] = {-n[1], n[0], 0};
+        axes[1] = n;
+        half = {0.5 * len, 0.5 * thick, 0};
+    } else {
+        f.forbid("length", "only in 2D (a 3D face is a rectangle, size, or a disc, radius)");
+        if (f.has("size") == f.has("radius"))
+            f.fail("size", "give one of size = [a, b] (a rectangle) or radius (a disc)");
+        Vec3d u = f.vector("axis", 3).value_or(std::abs(n[0]) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0});
+        const double un = u[0] * n[0] + u[1] * n[1] + u[2] * n[2];
+        for (int k = 0; k < 3; ++k) u[k] -= un * n[k];
+        const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        if (!(ul > 1e-9)) f.fail("axis", "must not be parallel to normal");
+        for (double& x : u) x /= ul;
+        axes = {u, cross(n, u), n};
+        if (f.has("size")) {
+            const Vec3d ab = *f.vector("size", 2);
+            if (!(ab[0] > 0 && ab[1] > 0)) f.fail("size", "must be > 0");
+            half = {0.5 * ab[0], 0.5 * ab[1], 0.5 * thick};
+        } else {
+            f.forbid("axis", "only for a rectangle (size)");
+            const double rad = f.requiredNumber("radius");
+            if (!(rad > 0)) f.fail("radius", "must be > 0");
+            half = {rad, rad, 0.5 * thick};
+            round = true;
+        }
+    }
+    for (int a = 0; a + 1 < dim; ++a)
+        if (half[a] < p.radiusMax)
+            f.fail(dim == 2 ? "length" : (round ? "radius" : "size"), "narrower than one particle diameter");
+    p.slab = true;
+    p.slabRound = round;
+    p.slabAxes = axes;
+    p.slabHalf = half;
+    for (int k = 0; k < 3; ++k) p.slabCentre[k] = c[k] + (k < dim ? 0.5 * thick * n[k] : 0.0);
+    // The bounding box, for the overlap grid: it must lie inside the domain.
+    for (int k = 0; k < dim; ++k) {
+        double e = 0;
+        for (int a = 0; a < dim; ++a) e += std::abs(axes[a][k]) * half[a];
+        p.regionLo[k] = p.slabCentre[k] - e;
+        p.regionHi[k] = p.slabCentre[k] + e;
+        if (p.regionLo[k] < domain.lo[k] - 1e-12 || p.regionHi[k] > domain.hi[k] + 1e-12)
+            r.fail("surface", std::string("the slab a batch fills (downstream of the face, velocity . normal x "
+                                          "interval thick) must lie inside the domain (axis ") +
+                                  kAxisName[k] + ")");
+    }
+}
+
 void readInletFlow(const TableReader& r, int dim, const Scenario& s, InletDef& in) {
     in.pos = r.tablePos();
     in.name = r.string("name").value_or("");
@@ -163,6 +243,8 @@ void readInletFlow(const TableReader& r, int dim, const Scenario& s, InletDef& i
     if (const auto iv = r.number("interval")) {
         if (!(*iv > 0)) r.fail("interval", "must be > 0");
         in.interval = *iv;
+    } else if (r.has("surface")) {
+        in.interval = 0;  // readSurface's default: it depends on the velocity across the face
     } else {
         // A batch leaves the region before the next one comes (LIGGGHTS's advice for insert/rate/region): the time
         // in which a particle starting at the inlet's velocity v, along v (or gravity), with the gravity component

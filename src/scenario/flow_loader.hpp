@@ -13,6 +13,11 @@ void readSizes(const TableReader& r, int dim, InsertDef& in);
 /// `cylinder = { center, radius, z }` of a 3D inlet: sets in.cylinder and the bounding box in.regionLo/Hi.
 void readCylinder(const TableReader& r, int dim, const DomainDef& domain, InsertDef& in);
 
+/// `surface = { center, normal, size | length | radius, axis }` of a surface inlet (as LIGGGHTS insert/stream):
+/// the slab one batch fills downstream of the face, v.n x interval thick (in.interval set before, or its default
+/// here), as in.slab; in.regionLo/Hi its bounding box. The velocity (read before) must cross the face.
+void readSurface(const TableReader& r, int dim, const DomainDef& domain, InletDef& in);
+
 /// The timing of an [[inlet]] (`rate` or `mass_rate`, `start`, `end`, `interval`) and its name; the region, sizes,
 /// shape and velocities are read before (in.particles), since `interval`'s default depends on them.
 void readInletFlow(const TableReader& r, int dim, const Scenario& s, InletDef& in);

@@ -170,6 +170,25 @@ template <int D>
 std::uint64_t RandomPlacer<D>::place(NewParticle<D>& p, Rng& rng, std::uint64_t tries) {
     const double r = p.radius;
     for (std::uint64_t t = 1; t <= tries; ++t) {
+        if (in_.slab) {  // a surface inlet's slab: uniform in its own frame, a disc face by rejection
+            Vec<D> local;
+            for (int a = 0; a < D; ++a) local[a] = (2 * rng.uniform() - 1) * (in_.slabHalf[std::size_t(a)] - r);
+            if (in_.slabRound) {
+                const double room = in_.slabHalf[0] - r;
+                double rho2 = 0;
+                for (int a = 0; a + 1 < D; ++a) rho2 += local[a] * local[a];
+                if (rho2 > room * room) continue;
+            }
+            for (int k = 0; k < D; ++k) {
+                p.x[k] = in_.slabCentre[std::size_t(k)];
+                for (int a = 0; a < D; ++a) p.x[k] += local[a] * in_.slabAxes[std::size_t(a)][std::size_t(k)];
+            }
+            if (clearOfWalls(s_, p.x, r) && !grid_.overlaps(p.x, r)) {
+                grid_.add(p.x, r);
+                return t;
+            }
+            continue;
+        }
         for (int a = 0; a < D; ++a) p.x[a] = lo_[a] + r + (hi_[a] - lo_[a] - 2 * r) * rng.uniform();
         if (in_.cylinder) {  // a vertical cylinder: the centre within R - r of the axis
             const double dx = p.x[0] - in_.cylinderCentre[0], dy = p.x[1] - in_.cylinderCentre[1];

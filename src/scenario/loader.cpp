@@ -323,9 +323,9 @@ private:
         const toml::array* inlets = root_.arrayOfTables("inlet");
         for (std::size_t i = 0; inlets && i < inlets->size(); ++i) {
             const TableReader r(*inlets->get(i)->as_table(), "inlet[" + std::to_string(i + 1) + "]", file_);
-            r.allowOnly({"name", "material", "region", "cylinder", "radius", "distribution", "velocity", "temperature",
-                         "rate", "mass_rate", "start", "end", "interval", "shape", "polygon", "sides", "aspect",
-                         "orientation"});
+            r.allowOnly({"name", "material", "region", "cylinder", "surface", "radius", "distribution", "velocity",
+                         "temperature", "rate", "mass_rate", "start", "end", "interval", "shape", "polygon", "sides",
+                         "aspect", "orientation"});
             InletDef in;
             InsertDef& p = in.particles;
             p.material = materialIndex(r, "material");
@@ -333,14 +333,15 @@ private:
             if (p.shape == ShapeKind::Polygon && s.method != Method::Tdm)
                 r.fail("shape", "polygons need method = \"tdm\" (the event-driven engine handles disks and spheres)");
             loader::readSizes(r, dim_, p);
-            if (r.has("cylinder"))
-                loader::readCylinder(r, dim_, domain_, p);
-            else
-                readRegion(r, p);
             p.velocity = r.vector("velocity", dim_).value_or(Vec3d{0, 0, 0});
             p.temperature = r.number("temperature").value_or(0.0);
             if (!(p.temperature >= 0)) r.fail("temperature", "must be >= 0");
+            if (r.has("cylinder"))
+                loader::readCylinder(r, dim_, domain_, p);
+            else if (!r.has("surface"))
+                readRegion(r, p);
             loader::readInletFlow(r, dim_, s, in);
+            if (r.has("surface")) loader::readSurface(r, dim_, domain_, in);
             s.inlets.push_back(std::move(in));
         }
         loader::nameFlows(s);
