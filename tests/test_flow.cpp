@@ -1,4 +1,4 @@
-// Particles that come and go (docs/physics.md H): inlets deliver their rate
+// Particles that come and go (docs/physics.md K): inlets deliver their rate
 // without overlap and report a shortfall, outlets remove exactly the particles
 // inside them, the counts balance in every method, the hybrid's books stay
 // balanced, results do not depend on the thread count, and bad input stops with

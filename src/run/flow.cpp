@@ -267,7 +267,7 @@ void describeFlows(const Scenario& sc, std::ostream& out) {
                                                   : (sc.dimension == 2 ? "through a segment" : "through a rectangle"))
                                    : (p.cylinder ? "in a cylinder" : "in a box");
         out << fmt::format(
-            "inlet      {}: {} {} from {:.4g} s to {:.4g} s, a batch every {:.4g} s (docs/physics.md H.3)\n", in.name,
+            "inlet      {}: {} {} from {:.4g} s to {:.4g} s, a batch every {:.4g} s (docs/physics.md K.3)\n", in.name,
             in.rate > 0 ? fmt::format("{:.4g} particles/s", in.rate) : fmt::format("{:.4g} kg/s", in.massRate), where,
             in.start, in.end, in.interval);
         describeSize("inlet " + in.name, in.particles.size, sc.dimension, out);

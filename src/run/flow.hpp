@@ -1,5 +1,5 @@
 #pragma once
-// Particles that come and go during a run (docs/physics.md H): inlets that insert particles in batches at a rate,
+// Particles that come and go during a run (docs/physics.md K): inlets that insert particles in batches at a rate,
 // outlets that remove the particles whose centre enters their region, and their books (series.csv, run.json).
 // The run loop (run/runner.cpp) asks Flow when it must act next and lets it act there, through the engine's
 // FlowHost; Flow itself knows no engine.

@@ -85,7 +85,7 @@ public:
     virtual void describe(JsonObject& j) const = 0;  ///< engine facts for run.json
     /// Hybrid runs: the engine, for the mode field, the zone grid and the picture. Others: nullptr.
     virtual const HaetEngine<D>* hybrid() const { return nullptr; }
-    /// The time-driven step [s]; 0 for a pure event-driven run (the outlets' cadence, docs/physics.md H.2).
+    /// The time-driven step [s]; 0 for a pure event-driven run (the outlets' cadence, docs/physics.md K.2).
     virtual double stepTime() const = 0;
 };
 

@@ -148,7 +148,7 @@ struct InsertDef {
 
 enum class OutletKind { Box, HalfSpace };
 
-/// An [[outlet]]: particles whose centre enters the region are removed (docs/physics.md H).
+/// An [[outlet]]: particles whose centre enters the region are removed (docs/physics.md K).
 struct OutletDef {
     std::string name;  ///< column prefix in series.csv; empty: "outlet1", "outlet2", ... by file order
     OutletKind kind = OutletKind::Box;
@@ -159,7 +159,7 @@ struct OutletDef {
     SourcePos pos;
 };
 
-/// An [[inlet]]: particles appear in a region at a rate, in batches (docs/physics.md H).
+/// An [[inlet]]: particles appear in a region at a rate, in batches (docs/physics.md K).
 struct InletDef {
     std::string name;  ///< column prefix in series.csv; empty: "inlet1", "inlet2", ... by file order
     /// What is inserted and where: arrangement random, count unused; region (box or cylinder), size distribution,

@@ -20,10 +20,6 @@
 namespace haet {
 namespace {
 
-using loader::emptyTable;
-using loader::kAxisName;
-using loader::TableReader;
-
 class Loader {
 public:
     Loader(const toml::table& root, std::string file, std::filesystem::path dir)

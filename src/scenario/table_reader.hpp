@@ -1,7 +1,6 @@
 #pragma once
-// The scenario loader's reader of one TOML table (scenario/loader.cpp, scenario/flow_loader.cpp): every value with
-// its dotted key path and line, so that every error is "file:line: key: what is wrong". Only the loader's files
-// include it (toml++ stays at the edge).
+// The scenario loader's reader of one TOML table (scenario/loader.cpp, scenario/flow_loader.cpp): typed values with
+// the dotted key path and the line of each, so that every error is "file:line: key: what is wrong".
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -18,7 +17,7 @@
 #include "scenario/definition.hpp"
 #include "scenario/text.hpp"
 
-namespace haet::loader {
+namespace haet {
 
 inline const char* const kAxisName[3] = {"x", "y", "z"};
 
@@ -224,4 +223,4 @@ inline const toml::table& emptyTable() {
     return empty;
 }
 
-}  // namespace haet::loader
+}  // namespace haet
