@@ -422,4 +422,17 @@ TEST_F(Cli, BlowUpExitsThreeAndKeepsOutputs) {
     EXPECT_GE(checkPvd(out / "particles.pvd"), 1);  // the snapshot at t = 0
 }
 
+// The example of particles that come and go (examples/pour3d.toml): `haet check` describes its inlet, sizes and
+// outlet; a bad inlet is bad input (exit 2 with file:line: key), in check and run alike.
+TEST_F(Cli, CheckDescribesInletAndOutletOfThePourScene) {
+    const Result r = haet(std::string("check '") + HAET_SOURCE_DIR + "/examples/pour3d.toml'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("inlet      feed: 4000 particles/s"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("d50"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("outlet     drain: box"), std::string::npos) << r.out;
+    std::string text = read(fs::path(HAET_SOURCE_DIR) / "examples" / "pour3d.toml");
+    text.replace(text.find("rate = 4000"), 11, "rate = 0");
+    expectBadInput(text, "rate = 0", "inlet[1].rate");
+}
+
 }  // namespace

@@ -172,6 +172,12 @@ struct Particles {
         forEachArray([&](auto& arr) { std::swap(arr[i], arr[j]); });
     }
 
+    /// Drops the last particle (all fields; a polygon's shape stays in `shapes`, unreferenced). Particles leave a
+    /// run this way (an outlet): whoever removes one first exchanges it with the last (swapEntries).
+    void popBack() {
+        forEachArray([](auto& arr) { arr.pop_back(); });
+    }
+
     /// Applies a permutation: new index k holds old particle order[k]. Used for spatial sorting. A shorter order
     /// permutes the first order.size() particles only.
     void permute(const std::vector<std::uint32_t>& order) {

@@ -12,6 +12,8 @@ namespace haet {
 /// Stream ids: one per operation that draws random numbers, so two operations never share a sequence.
 enum class RngStream : std::uint64_t {
     Insert = 1,  ///< particle insertion (positions, radii, velocities)
+    /// Inlets (run/flow.hpp): inlet k, 0-based in file order, draws from stream InletFirst + k.
+    InletFirst = 0x100,
 };
 
 /// One Philox4x32-10 block: 128-bit counter and 64-bit key to 128 random bits.

@@ -82,6 +82,7 @@ void EdmEngine<D>::reset() {
         rmax_ = std::max(rmax_, p.radius[i]);
         if (i >= first && !p.frozen(i)) ++nMoving_;
     }
+    rmax_ = std::max(rmax_, s_.radiusBound);
     for (int k = 0; k < D; ++k)
         if (w_.domain.periodic[k] && sl_.boxLen[k] < 4 * rmax_)
             throw std::invalid_argument("event-driven engine: periodic axis " + std::to_string(k) +
@@ -615,6 +616,29 @@ void EdmEngine<D>::add(std::size_t i, double t) {
     std::sort(around.begin(), around.end());
     around.erase(std::unique(around.begin(), around.end()), around.end());
     for (const std::uint32_t j : around) predict(j, t);
+}
+
+template <int D>
+void EdmEngine<D>::grow(std::size_t n) {
+    if (s_.holdState) throw std::logic_error("event-driven engine: grow needs holdState off");
+    if (n >= (1u << kTypeShift)) throw std::invalid_argument("event-driven engine: too many particles");
+    if (slotOf_.size() < n) slotOf_.resize(n, kNil);
+    const std::size_t old = sl_.size();
+    if (n <= old) return;
+    // New slots are free (no particle, no event) and belong to no cell: nothing else refers to them yet.
+    std::vector<double> times(n, kNever);
+    for (std::size_t s = 0; s < old; ++s) times[s] = queue_.time(static_cast<std::uint32_t>(s));
+    sl_.hot.resize(n, Hot{Vec<D>::zero(), kNever, Vec<D>::zero(), 0.0});
+    sl_.link.resize(n, Link{kNil, 0, Sl::packWraps(Shift{})});
+    sl_.rec.resize(n, Rec{Kept{}, 0, 0, 0, 0});
+    for (std::size_t s = old; s < n; ++s) {
+        sl_.rec[s].idx = kNil;
+        sl_.rec[s].cell = grid_.count();
+    }
+    tc_.grow(n);
+    queue_.build(times);
+    if (shells_.on()) throw std::logic_error("event-driven engine: grow needs cell crossings (shell = 0)");
+    for (std::size_t s = n; s-- > old;) free_.push_back(static_cast<std::uint32_t>(s));
 }
 
 template <int D>

@@ -62,6 +62,9 @@ struct EdmSettings {
     /// World index of the first particle this engine owns. Those before it belong to another engine (the
     /// time-driven one of a hybrid run) and are invisible here; particles join and leave with add() and remove().
     std::size_t firstParticle = 0;
+    /// The largest radius a particle may have that joins later (an inlet's) [m]: the grid is sized for it as for
+    /// the particles at the start. 0: those at the start.
+    double radiusBound = 0;
     /// Reference twin: the next event by brute force (all pairs and all walls at every event, O(N^2) per event),
     /// no cells, no queue. For tests.
     bool reference = false;
@@ -124,6 +127,8 @@ public:
     void remove(std::size_t i, double t);
     /// Particle i (not owned) joins at time t with its World state.
     void add(std::size_t i, double t);
+    /// Room for World particles [0, n): particles appended to the World (an inlet's) can then join with add().
+    void grow(std::size_t n);
     /// The World exchanged particles i and j (Particles::swapEntries); owned or not.
     void swapIndices(std::size_t i, std::size_t j);
     /// Position of owned particle i at time t (>= its clock), wrapped into the box [m].

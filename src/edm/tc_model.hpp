@@ -23,6 +23,10 @@ public:
         else
             std::vector<double>().swap(last_);
     }
+    /// Room for n slots; the new ones have not collided.
+    void grow(std::size_t n) {
+        if (on() && last_.size() < n) last_.resize(n, -std::numeric_limits<double>::infinity());
+    }
     /// Slots renumbered: slot k is old slot order[k].
     void permute(const std::vector<std::uint32_t>& order) {
         if (last_.empty()) return;

@@ -21,7 +21,7 @@ double largestRadius(const Particles<D>& p) {
 /// Defaults that depend on the particles: the zone edge is 4 largest diameters, never below one.
 template <int D>
 HaetSettings resolved(const World<D>& w, HaetSettings hs) {
-    const double d = 2 * largestRadius(w.particles);
+    const double d = 2 * std::max(largestRadius(w.particles), hs.radiusBound);
     if (!(hs.zones.size > 0)) hs.zones.size = 4 * d;
     hs.zones.size = std::max(hs.zones.size, d);
     if (!(hs.zones.size > 0)) hs.zones.size = 1;
@@ -36,7 +36,7 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
     : w_(world), ts_(tdm), hs_(resolved(world, hs)), zones_(world.domain, hs_.zones), book_(zones_, guard_) {
     Particles<D>& p = w_.particles;
     const std::size_t n = p.size();
-    const double rmax = largestRadius(p);
+    const double rmax = std::max(largestRadius(p), hs_.radiusBound);
 
     // Initial labels from every particle, then the split: time-driven particles first.
     zones_.relabel(p, {});
@@ -56,6 +56,7 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
     // TDM particle's cell is at least a skin's width from touching it (docs/haet.md). Unless the scenario sets it,
     // the edge balances cell crossings against candidates per prediction for the event-driven particles' density.
     edm.firstParticle = nT;
+    edm.radiusBound = rmax;
     edm.tcTime = hs_.dtMin > 0 ? hs_.dtMin : w_.contact.contactTime;
     edm.tcModel = true;
     if (!(edm.cellSize > 0)) edm.cellSize = eventCellEdge(nT);
@@ -560,7 +561,9 @@ HaetEnergy HaetEngine<D>::energy() const {
     for (std::size_t i = 0; i < w_.particles.size(); ++i) e.total += particleEnergy(i);
     e.dissipatedEdm = edm_->stats().dissipated;
     e.dissipatedTdm = tdm0_ - tdmEnergy() + tdmIn_ - tdmOut_;
-    e.unaccounted = e.initial - e.total - e.dissipatedTdm - e.dissipatedEdm;
+    e.inflow = inflow_;
+    e.outflow = outflow_;
+    e.unaccounted = e.initial + e.inflow - e.outflow - e.total - e.dissipatedTdm - e.dissipatedEdm;
     return e;
 }
 

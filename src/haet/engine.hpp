@@ -22,13 +22,14 @@
 namespace haet {
 
 struct HaetSettings {
-    ZoneSettings zones;     ///< zone edge, phi_on / phi_off, buffer (docs/physics.md A.2)
-    int relabelEvery = 50;  ///< zones are re-labelled, and particles change mode, every this many steps [steps];
-                            ///< the guard follows the TDM particles at every pair-list build
-    int diluteSteps = 20;   ///< a time-driven particle without contacts returns to EDM once its zone has been
-                            ///< event-driven this long [steps]
-    double dtMin = 0;       ///< modified EDM (A.4): a collision within dtMin of the particle's previous one hands
-                            ///< both particles to the TDM [s]; 0: the contact duration
+    ZoneSettings zones;      ///< zone edge, phi_on / phi_off, buffer (docs/physics.md A.2)
+    int relabelEvery = 50;   ///< zones are re-labelled, and particles change mode, every this many steps [steps];
+                             ///< the guard follows the TDM particles at every pair-list build
+    int diluteSteps = 20;    ///< a time-driven particle without contacts returns to EDM once its zone has been
+                             ///< event-driven this long [steps]
+    double dtMin = 0;        ///< modified EDM (A.4): a collision within dtMin of the particle's previous one hands
+                             ///< both particles to the TDM [s]; 0: the contact duration
+    double radiusBound = 0;  ///< the largest radius of particles added later (inlets) [m]; 0: those at the start
 };
 
 /// Where the energy went, since the start [J]. Potential energy is that of gravity, -m g.x (unwrapped x).
@@ -37,8 +38,10 @@ struct HaetEnergy {
     double dissipatedTdm = 0;  ///< lost in time-driven contacts (the TDM particles' energy balance)
     double dissipatedEdm = 0;  ///< lost in event-driven collisions (summed at each collision)
     double total = 0;          ///< total energy now
-    /// initial - total - dissipatedTdm - dissipatedEdm: what neither engine accounts for (moving walls'
-    /// work, round-off). Zero for static walls, to the accuracy of the time integration.
+    double inflow = 0;         ///< brought by particles that were added (inlets), at their birth
+    double outflow = 0;        ///< taken away by particles that were removed (outlets), their contacts' included
+    /// initial + inflow - outflow - total - dissipatedTdm - dissipatedEdm: what neither engine accounts for
+    /// (moving walls' work, round-off). Zero for static walls, to the accuracy of the time integration.
     double unaccounted = 0;
 };
 
@@ -80,6 +83,14 @@ public:
     const HaetSettings& settings() const { return hs_; }
     double dtMin() const { return edm_->tcTime(); }
     double dt() const { return ts_.dt; }
+
+    // ---- particles that come and go (run/flow.hpp; haet/flow.cpp, docs/haet.md "Inlets and outlets") ----
+    /// Removes World particles `which` (ascending, distinct; either mode) at world.time; the others keep their
+    /// state, the store shrinks by which.size() (the removed ones are exchanged with the last ones first).
+    void removeParticles(const std::vector<std::uint32_t>& which);
+    /// Particles [first, size()) were appended to the World at world.time (synchronise() first): each is born in
+    /// the mode of its zone, time-driven in a time-driven zone, event-driven elsewhere.
+    void addParticles(std::size_t first);
 
     /// Sets particle modes by hand (tests): toTdm / toEdm list World indices; rules apply again at the next
     /// relabel unless freezeModes(true).
@@ -161,6 +172,7 @@ private:
     bool frozenModes_ = false;
     HaetCounters counters_;
     double e0_ = 0, tdmIn_ = 0, tdmOut_ = 0, tdm0_ = 0;
+    double inflow_ = 0, outflow_ = 0;  // energy brought by added particles, taken by removed ones [J]
 };
 
 extern template class HaetEngine<2>;

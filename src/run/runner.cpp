@@ -22,6 +22,7 @@
 #include "io/series.hpp"
 #include "io/vtk.hpp"
 #include "polygon/output.hpp"
+#include "run/flow.hpp"
 #include "run/walls_output.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
@@ -59,9 +60,10 @@ Energies<D> energies(const World<D>& w) {
     return s;
 }
 
-/// What the run loop needs from an engine. Engine-specific measurements are extra series columns.
+/// What the run loop needs from an engine. Engine-specific measurements are extra series columns. As a FlowHost
+/// it lets the inlets and outlets (run/flow.hpp) add and remove particles.
 template <int D>
-class Driver {
+class Driver : public FlowHost<D> {
 public:
     virtual ~Driver() = default;
     virtual const char* method() const = 0;
@@ -84,6 +86,8 @@ public:
     virtual void describe(JsonObject& j) const = 0;  ///< engine facts for run.json
     /// Hybrid runs: the engine, for the mode field, the zone grid and the picture. Others: nullptr.
     virtual const HaetEngine<D>* hybrid() const { return nullptr; }
+    /// The time-driven step [s]; 0 for a pure event-driven run (the outlets' cadence, docs/physics.md K.2).
+    virtual double stepTime() const = 0;
 };
 
 template <int D>
@@ -114,9 +118,14 @@ public:
         j.add("neighbor_rebuilds", eng_.rebuilds());
     }
     const TdmEngine<D>& engine() const { return eng_; }
+    double stepTime() const override { return eng_.settings().dt; }
+    std::size_t eager() const override { return w_.particles.size(); }
+    void synchronise() override {}
+    void remove(const std::vector<std::uint32_t>& which) override { removeTimeDriven(w_, eng_, which); }
+    void added(std::size_t first) override { addTimeDriven(w_, eng_, first); }
 
 private:
-    const World<D>& w_;
+    World<D>& w_;
     TdmEngine<D> eng_;
     std::string note_;
 };
@@ -151,6 +160,15 @@ public:
         j.add("tc_elastic", eng_.stats().tcElastic);
         j.add("tc_time", eng_.tcTime());
     }
+    double stepTime() const override { return 0; }
+    std::size_t eager() const override { return 0; }
+    // Particles come and go between synchronisations: the World is current then, and the engine starts its events
+    // anew from it (reset: O(N), at the flows' cadence only when something changed).
+    void remove(const std::vector<std::uint32_t>& which) override {
+        dropParticles(w_.particles, which);
+        eng_.reset();
+    }
+    void added(std::size_t) override { eng_.reset(); }
 
 private:
     World<D>& w_;
@@ -175,15 +193,26 @@ public:
         return eng_.tdm().pairVirial() + (window > 0 ? collisions / window : 0.0);
     }
     std::vector<std::string> extraColumns() const override {
-        return {"n_tdm",  "n_edm",        "events",         "collisions",     "tdm_steps",         "to_tdm",
-                "to_edm", "tc_handovers", "dissipated_tdm", "dissipated_edm", "energy_unaccounted"};
+        return {"n_tdm",     "n_edm",        "events",         "collisions",     "tdm_steps",          "to_tdm",
+                "to_edm",    "tc_handovers", "dissipated_tdm", "dissipated_edm", "energy_unaccounted", "energy_in",
+                "energy_out"};
     }
     std::vector<std::optional<double>> extraRow() const override {
         const HaetEnergy e = eng_.energy();
         const HaetCounters& c = eng_.counters();
-        return {double(eng_.nTdm()),  double(eng_.nEdm()), double(eng_.events()), double(eng_.collisions()),
-                double(eng_.steps()), double(c.toTdm),     double(c.toEdm),       double(c.tcHandovers),
-                e.dissipatedTdm,      e.dissipatedEdm,     e.unaccounted};
+        return {double(eng_.nTdm()),
+                double(eng_.nEdm()),
+                double(eng_.events()),
+                double(eng_.collisions()),
+                double(eng_.steps()),
+                double(c.toTdm),
+                double(c.toEdm),
+                double(c.tcHandovers),
+                e.dissipatedTdm,
+                e.dissipatedEdm,
+                e.unaccounted,
+                e.inflow,
+                e.outflow};
     }
     void describe(JsonObject& j) const override {
         const HaetCounters& c = eng_.counters();
@@ -202,6 +231,10 @@ public:
         j.add("neighbor_rebuilds", eng_.tdm().rebuilds());
     }
     const HaetEngine<D>* hybrid() const override { return &eng_; }
+    double stepTime() const override { return eng_.dt(); }
+    std::size_t eager() const override { return eng_.nTdm(); }
+    void remove(const std::vector<std::uint32_t>& which) override { eng_.removeParticles(which); }
+    void added(std::size_t first) override { eng_.addParticles(first); }
 
 private:
     HaetEngine<D> eng_;
@@ -219,13 +252,17 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
         case Method::Edm: {
             world.particles.dropTdmState();  // forces and torques: nothing reads them in this run
             EdmSettings es = edmSettings(sc);
-            es.holdState = true;  // positions, velocities and radii only in the engine between synchronisations
+            es.holdState = true;
+            es.radiusBound =
+                inletRadiusBound(sc);  // positions, velocities and radii only in the engine between synchronisations
             return std::make_unique<EdmDriver<D>>(world, es);
         }
         case Method::Haet: {
             std::string note;
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
-            return std::make_unique<HaetDriver<D>>(world, ts, edmSettings(sc), haetSettings<D>(sc), note);
+            HaetSettings hs = haetSettings<D>(sc);
+            hs.radiusBound = inletRadiusBound(sc);
+            return std::make_unique<HaetDriver<D>>(world, ts, edmSettings(sc), hs, note);
         }
     }
     throw ScenarioError({sc.path, 0}, "method", "unknown method");
@@ -402,6 +439,8 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         "time",         "step",        "kinetic_energy", "rotational_energy", "potential_energy", "elastic_energy",
         "total_energy", "n_particles", "n_contacts",     "max_overlap_ratio", "pressure"};
     for (auto& c : eng->extraColumns()) columns.push_back(c);
+    Flow<D> flow(sc, world, eng->stepTime());
+    for (auto& c : flow.columns()) columns.push_back(c);
     SeriesWriter series(dir / "series.csv", columns);
     SnapshotWriter<D> snaps(dir);
     double lastRowTime = world.time;
@@ -425,6 +464,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                                                   eng->maxOverlapRatio(),
                                                   pressure};
         for (auto& v : eng->extraRow()) row.push_back(v);
+        for (auto& v : flow.row()) row.push_back(v);
         series.row(row);
     };
 
@@ -448,6 +488,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         j.add("simulated_time", world.time);
         j.add("steps", eng->steps());
         eng->describe(j);
+        flow.describe(j);
         j.add("wall_time", wall);
         j.add("particle_steps_per_second", wall > 0 ? double(eng->steps()) * world.particles.size() / wall : 0.0);
         j.add("threads", static_cast<std::int64_t>(omp_get_max_threads()));
@@ -485,7 +526,8 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
             double target = std::min(sc.duration, nextSeries);
             if (snapPeriod > 0) target = std::min(target, nextSnap);
             while (world.time + eps < target) {
-                eng->advanceTo(std::min(target, world.time + chunk));
+                eng->advanceTo(std::min({target, world.time + chunk, flow.nextTime()}));
+                if (world.time + eps >= flow.nextTime()) flow.act(world, *eng, eps);
                 progress.update(world.time, eng->steps(), eng->contacts());
             }
         }
@@ -624,7 +666,7 @@ void describeHaet(const Scenario& sc, std::ostream& out) {
         tdmReferences(sc, ts.integrator, false));
 }
 
-void describeScenario(const Scenario& sc, std::ostream& out) {
+static void describeMethod(const Scenario& sc, std::ostream& out) {
     if (sc.method == Method::Haet) {
         if (sc.dimension == 2)
             describeHaet<2>(sc, out);
@@ -643,6 +685,11 @@ void describeScenario(const Scenario& sc, std::ostream& out) {
         describeTdm<2>(sc, out);
     else
         describeTdm<3>(sc, out);
+}
+
+void describeScenario(const Scenario& sc, std::ostream& out) {
+    describeMethod(sc, out);
+    describeFlows(sc, out);
 }
 
 }  // namespace haet

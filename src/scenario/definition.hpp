@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "contact/model.hpp"
+#include "scenario/distribution.hpp"
 
 namespace haet {
 
@@ -140,12 +141,25 @@ struct WallDef {
 struct InsertDef {
     Arrangement arrangement = Arrangement::Random;
     std::size_t count = 0;                ///< number of particles (lattice: at most this many)
-    double radiusMin = 0, radiusMax = 0;  ///< radius range [m], uniform; equal for monodisperse
+    double radiusMin = 0, radiusMax = 0;  ///< radius range [m]: the bounds of `size`; equal for monodisperse
+    SizeDistribution size;                ///< radius distribution (docs/scenario.md, "Size distributions")
     int material = 0;
     Vec3d regionLo{0, 0, 0}, regionHi{0, 0, 0};  ///< box the centres+radii must fit in [m]
-    std::optional<double> spacing;               ///< lattice spacing [m]; default 2 * radius_max
-    Vec3d velocity{0, 0, 0};                     ///< mean velocity [m/s]
-    double temperature = 0;                      ///< velocity variance per component [m^2/s^2] (Maxwellian)
+    /// Inlets in 3D: a vertical cylinder (axis along z) instead of the box, which is then its bounding box.
+    bool cylinder = false;
+    std::array<double, 2> cylinderCentre{0, 0};  ///< axis position (x, y) [m]
+    double cylinderRadius = 0;                   ///< [m]
+    /// Surface inlets: the slab a batch fills, downstream of the face, instead of the box (then its bounding box):
+    /// centre, orthonormal axes (the last one the face's normal), half-extents along them; `slabRound`: a disc
+    /// face, radius slabHalf[0] about the last axis.
+    bool slab = false;
+    Vec3d slabCentre{0, 0, 0};        ///< [m]
+    std::array<Vec3d, 3> slabAxes{};  ///< unit vectors
+    Vec3d slabHalf{0, 0, 0};          ///< [m]
+    bool slabRound = false;
+    std::optional<double> spacing;  ///< lattice spacing [m]; default 2 * radius_max
+    Vec3d velocity{0, 0, 0};        ///< mean velocity [m/s]
+    double temperature = 0;         ///< velocity variance per component [m^2/s^2] (Maxwellian)
     bool frozen = false;
     std::string file;  ///< arrangement = File: path (resolved against the scenario dir)
     FileFormat format = FileFormat::Csv;
@@ -156,6 +170,35 @@ struct InsertDef {
     int sidesMin = 0, sidesMax = 0;     ///< vertices per polygon, uniform in [min, max] (regular: min = max)
     double aspect = 1;                  ///< rectangle: side ratio (x over y) [-]; random: largest stretch [-]
     std::optional<double> orientation;  ///< [rad]; unset = uniform random in [0, 2 pi)
+    SourcePos pos;
+};
+
+// ---- Flows: particles that come and go during the run (docs/scenario.md, "Inlets" and "Outlets") ----------------
+
+enum class OutletKind { Box, HalfSpace };
+
+/// An [[outlet]]: particles whose centre enters the region are removed (docs/physics.md K).
+struct OutletDef {
+    std::string name;  ///< column prefix in series.csv; empty: "outlet1", "outlet2", ... by file order
+    OutletKind kind = OutletKind::Box;
+    Vec3d lo{0, 0, 0}, hi{0, 0, 0};  ///< box [m]
+    Vec3d point{0, 0, 0};            ///< half-space: a point on its plane [m]
+    Vec3d normal{0, 0, 1};           ///< half-space: unit normal pointing into the removed side
+    double interval = 0;             ///< [s] between checks of event-driven particles; 0: duration / 1000
+    SourcePos pos;
+};
+
+/// An [[inlet]]: particles appear in a region at a rate, in batches (docs/physics.md K).
+struct InletDef {
+    std::string name;  ///< column prefix in series.csv; empty: "inlet1", "inlet2", ... by file order
+    /// What is inserted and where: arrangement random, count unused; region (box or cylinder), size distribution,
+    /// material, velocity, temperature, shape.
+    InsertDef particles;
+    double rate = 0;      ///< [particles/s]; 0 when massRate is given
+    double massRate = 0;  ///< [kg/s] (2D: kg/(m s), per unit depth as every 2D mass); 0 when rate is given
+    double start = 0;     ///< first batch [s]
+    double end = 0;       ///< no particle is due after this time [s]
+    double interval = 0;  ///< [s] between batches
     SourcePos pos;
 };
 
@@ -181,6 +224,8 @@ struct Scenario {
     HaetDef haet;
     std::vector<WallDef> walls;
     std::vector<InsertDef> inserts;
+    std::vector<OutletDef> outlets;
+    std::vector<InletDef> inlets;
     OutputDef output;
     std::string hash;                    ///< hash of the file contents (hex)
     std::vector<std::string> overrides;  ///< command-line overrides applied to the file, "KEY=VALUE" (loader.hpp)

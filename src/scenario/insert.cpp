@@ -97,79 +97,6 @@ Vec<D> toVec(const Vec3d& a) {
     return v;
 }
 
-/// Linked-cell grid over a box, for the overlap test of a candidate against the particles placed so far.
-/// The cell edge is at least the largest diameter, so a candidate can only overlap particles in the 3^D cells
-/// around its own. Points beyond the box are stored in the border cells (clamped), which keeps that rule true.
-template <int D>
-class OverlapGrid {
-public:
-    /// Box [lo, hi]; `maxRadius` bounds every radius that will be added or tested [m]; `expected` is the number of
-    /// particles that will be added, used to keep the cell count proportional to it.
-    OverlapGrid(const Vec<D>& lo, const Vec<D>& hi, double maxRadius, std::size_t expected) {
-        double cell = 2 * maxRadius;
-        const double cap = std::max(4096.0, std::min(8.0 * double(expected), double(1u << 22)));
-        auto cellCount = [&](double c) {
-            double n = 1;
-            for (int k = 0; k < D; ++k) n *= std::max(1.0, std::ceil((hi[k] - lo[k]) / c));
-            return n;
-        };
-        while (cellCount(cell) > cap) cell *= 1.5;
-        std::array<int, D> n;
-        for (int k = 0; k < D; ++k) n[k] = std::max(1, int(std::ceil((hi[k] - lo[k]) / cell)));
-        grid_ = CellGrid<D>(lo, n, Vec<D>::filled(cell), std::array<bool, D>{});
-        head_.assign(std::size_t(grid_.count()), kNone);
-    }
-
-    void add(const Vec<D>& x, double r) {
-        const std::size_t c = std::size_t(grid_.cellOf(x));
-        x_.push_back(x);
-        r_.push_back(r);
-        next_.push_back(head_[c]);
-        head_[c] = std::uint32_t(x_.size() - 1);
-    }
-
-    bool overlaps(const Vec<D>& x, double r) const {
-        return grid_.forEachNeighbour(grid_.coordsOf(x), [&](int c, int) {
-            for (std::uint32_t j = head_[std::size_t(c)]; j != kNone; j = next_[j]) {
-                const double reach = r + r_[j];
-                // Touching (distance equal to the sum of radii, up to rounding) is allowed: a lattice of
-                // spacing 2r touches exactly.
-                if (norm2(x - x_[j]) < reach * reach * (1 - 1e-12)) return true;
-            }
-            return false;
-        });
-    }
-
-private:
-    static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-
-    CellGrid<D> grid_;  // open on every axis
-    std::vector<std::uint32_t> head_;
-    std::vector<std::uint32_t> next_;
-    std::vector<Vec<D>> x_;
-    std::vector<double> r_;
-};
-
-/// A particle about to be added to the store.
-template <int D>
-struct NewParticle {
-    Vec<D> x{};
-    Vec<D> v{};
-    Ang<D> w{};
-    double radius = 0;
-    double density = 0;  ///< [kg/m^3] (2D: [kg/m^2])
-    std::uint16_t material = 0;
-    std::uint8_t flags = 0;
-    std::array<std::int32_t, D> image{};  ///< periodic box crossings (Particles::image)
-    std::vector<Vec<2>> body;             ///< polygon vertices in the body frame [m]; empty for a disk or sphere
-    double orientation = 0;               ///< polygon angle [rad]
-
-    double mass() const {
-        if (body.empty()) return density * Particles<D>::volumeOf(radius);
-        return density * polygon::polygonMoments(body.data(), int(body.size())).area;
-    }
-};
-
 /// The polygon of an insert with shape = "polygon", circumradius r, drawn after the particle's position.
 template <int D>
 void makePolygon(const InsertDef& in, NewParticle<D>& p, Rng& rng) {
@@ -190,6 +117,18 @@ void makePolygon(const InsertDef& in, NewParticle<D>& p, Rng& rng) {
     }
 }
 
+}  // namespace
+
+template <int D>
+void finishParticle(const Scenario& s, const InsertDef& in, NewParticle<D>& p, Rng& rng) {
+    makePolygon(in, p, rng);
+    p.density = s.materials[std::size_t(in.material)].density;
+    p.material = std::uint16_t(in.material);
+    p.flags = in.frozen ? kFrozen : 0;
+}
+
+namespace {
+
 /// A grid over the insert's region, expanded by one cell, holding the store's particles that could touch it.
 template <int D>
 OverlapGrid<D> gridWithExisting(const Particles<D>& store, const Vec<D>& lo, const Vec<D>& hi, double radiusMax,
@@ -206,19 +145,78 @@ OverlapGrid<D> gridWithExisting(const Particles<D>& store, const Vec<D>& lo, con
     return grid;
 }
 
+}  // namespace
+
+template <int D>
+RandomPlacer<D>::RandomPlacer(const Scenario& s, const InsertDef& in, const Particles<D>& store, std::size_t expected)
+    : s_(s),
+      in_(in),
+      lo_(toVec<D>(in.regionLo)),
+      hi_(toVec<D>(in.regionHi)),
+      grid_(gridWithExisting(store, lo_, hi_, in.radiusMax, expected)),
+      walls_(std::make_unique<const WallClearance<D>>(s.walls)) {}
+
+template <int D>
+RandomPlacer<D>::~RandomPlacer() = default;
+template <int D>
+RandomPlacer<D>::RandomPlacer(RandomPlacer&&) noexcept = default;
+
+template <int D>
+std::uint64_t RandomPlacer<D>::place(NewParticle<D>& p, Rng& rng, std::uint64_t tries) {
+    const double r = p.radius;
+    for (std::uint64_t t = 1; t <= tries; ++t) {
+        if (in_.slab) {  // a surface inlet's slab: uniform in its own frame, a disc face by rejection
+            Vec<D> local;
+            for (int a = 0; a < D; ++a) local[a] = (2 * rng.uniform() - 1) * (in_.slabHalf[std::size_t(a)] - r);
+            if (in_.slabRound) {
+                const double room = in_.slabHalf[0] - r;
+                double rho2 = 0;
+                for (int a = 0; a + 1 < D; ++a) rho2 += local[a] * local[a];
+                if (rho2 > room * room) continue;
+            }
+            for (int k = 0; k < D; ++k) {
+                p.x[k] = in_.slabCentre[std::size_t(k)];
+                for (int a = 0; a < D; ++a) p.x[k] += local[a] * in_.slabAxes[std::size_t(a)][std::size_t(k)];
+            }
+            if (walls_->clear(p.x, r) && !grid_.overlaps(p.x, r)) {
+                grid_.add(p.x, r);
+                return t;
+            }
+            continue;
+        }
+        for (int a = 0; a < D; ++a) p.x[a] = lo_[a] + r + (hi_[a] - lo_[a] - 2 * r) * rng.uniform();
+        if (in_.cylinder) {  // a vertical cylinder: the centre within R - r of the axis
+            const double dx = p.x[0] - in_.cylinderCentre[0], dy = p.x[1] - in_.cylinderCentre[1];
+            const double room = in_.cylinderRadius - r;
+            if (dx * dx + dy * dy > room * room) continue;
+        }
+        if (walls_->clear(p.x, r) && !grid_.overlaps(p.x, r)) {
+            grid_.add(p.x, r);
+            return t;
+        }
+    }
+    return 0;
+}
+
+template <int D>
+void thermalVelocity(const InsertDef& in, NewParticle<D>& p, Rng& rng) {
+    p.v = toVec<D>(in.velocity);
+    if (in.temperature > 0 && !in.frozen) {
+        const double sigma = std::sqrt(in.temperature);
+        for (int k = 0; k < D; ++k) p.v[k] += sigma * rng.normal();
+    }
+}
+
+namespace {
+
 /// Velocities of a lattice or random insert: the mean `velocity` plus, when temperature > 0, a Maxwellian with
 /// variance `temperature` per component whose net momentum is then removed, so the insert moves with `velocity`.
 /// Frozen particles get `velocity` alone.
 template <int D>
 void assignVelocities(const InsertDef& in, std::vector<NewParticle<D>>& out, Rng& rng) {
     const Vec<D> mean = toVec<D>(in.velocity);
-    const double sigma = std::sqrt(in.temperature);
     const bool thermal = in.temperature > 0 && !in.frozen;
-    for (auto& p : out) {
-        p.v = mean;
-        if (thermal)
-            for (int k = 0; k < D; ++k) p.v[k] += sigma * rng.normal();
-    }
+    for (auto& p : out) thermalVelocity(in, p, rng);
     if (!thermal || out.empty()) return;
     Vec<D> momentum = Vec<D>::zero();  // of the thermal part [kg m/s]
     double massSum = 0;
@@ -257,7 +255,7 @@ std::vector<NewParticle<D>> insertLattice(const Scenario& s, std::size_t k, cons
         NewParticle<D> p;
         for (int a = 0; a < D; ++a)
             p.x[a] = std::min(lo[a] + in.radiusMax + double(site[a]) * spacing, hi[a] - in.radiusMax);
-        p.radius = rng.uniform(in.radiusMin, in.radiusMax);
+        p.radius = in.size.sample(rng);
         if (walls.clear(p.x, p.radius) && !grid.overlaps(p.x, p.radius)) {
             makePolygon(in, p, rng);
             p.density = mat.density;
@@ -276,36 +274,26 @@ std::vector<NewParticle<D>> insertLattice(const Scenario& s, std::size_t k, cons
 template <int D>
 std::vector<NewParticle<D>> insertRandom(const Scenario& s, std::size_t k, const Particles<D>& store, Rng& rng) {
     const InsertDef& in = s.inserts[k];
-    const Vec<D> lo = toVec<D>(in.regionLo), hi = toVec<D>(in.regionHi);
-    OverlapGrid<D> grid = gridWithExisting(store, lo, hi, in.radiusMax, in.count);
-    const MaterialDef& mat = s.materials[std::size_t(in.material)];
+    RandomPlacer<D> placer(s, in, store, in.count);
     // Random sequential addition slows down sharply near its jamming limit (~0.38 volume fraction in 3D, ~0.55 area
     // fraction in 2D); these bounds end a hopeless insert in well under a second instead of running on.
     const std::uint64_t maxConsecutive = 20000;
     const std::uint64_t maxTotal = 200 * std::uint64_t(in.count) + 100000;
     std::uint64_t attempts = 0;
-    const WallClearance<D> walls(s.walls);
     std::vector<NewParticle<D>> out;
     out.reserve(in.count);
     for (std::size_t i = 0; i < in.count; ++i) {
         NewParticle<D> p;
-        p.radius = rng.uniform(in.radiusMin, in.radiusMax);
-        bool placed = false;
-        for (std::uint64_t tries = 0; tries < maxConsecutive && attempts < maxTotal && !placed; ++tries) {
-            ++attempts;
-            for (int a = 0; a < D; ++a) p.x[a] = lo[a] + p.radius + (hi[a] - lo[a] - 2 * p.radius) * rng.uniform();
-            placed = walls.clear(p.x, p.radius) && !grid.overlaps(p.x, p.radius);
-        }
-        if (!placed)
+        p.radius = in.size.sample(rng);
+        const std::uint64_t tries = std::min(maxConsecutive, maxTotal - std::min(maxTotal, attempts));
+        const std::uint64_t used = placer.place(p, rng, tries);
+        attempts += used ? used : tries;
+        if (!used)
             throw ScenarioError(in.pos, insertKey(k) + ".count",
                                 "could not place " + std::to_string(in.count) +
                                     " particles without overlap: region too small (placed " + std::to_string(i) +
                                     " in " + std::to_string(attempts) + " attempts)");
-        grid.add(p.x, p.radius);
-        makePolygon(in, p, rng);
-        p.density = mat.density;
-        p.material = std::uint16_t(in.material);
-        p.flags = in.frozen ? kFrozen : 0;
+        finishParticle(s, in, p, rng);
         out.push_back(p);
     }
     assignVelocities(in, out, rng);
@@ -727,22 +715,33 @@ void insertParticles(const Scenario& s, Particles<D>& particles, Rng rng) {
                 break;
         }
         // Added only once the whole insert succeeded, so a failed insert leaves no partial block behind.
-        for (const auto& p : out) {
-            std::size_t i;
-            if constexpr (D == 2) {
-                i = p.body.empty()
-                        ? particles.add(p.x, p.v, p.w, p.radius, p.density, p.material, particles.size(), p.flags)
-                        : particles.addPolygon(p.x, p.v, p.w, p.orientation, p.body, p.density, p.material,
-                                               particles.size(), p.flags);
-            } else {
-                i = particles.add(p.x, p.v, p.w, p.radius, p.density, p.material, particles.size(), p.flags);
-            }
-            particles.image[i] = p.image;
-        }
+        for (const auto& p : out) addToStore(particles, p, particles.size());
     }
+}
+
+template <int D>
+std::size_t addToStore(Particles<D>& particles, const NewParticle<D>& p, std::uint64_t id) {
+    std::size_t i;
+    if constexpr (D == 2) {
+        i = p.body.empty()
+                ? particles.add(p.x, p.v, p.w, p.radius, p.density, p.material, id, p.flags)
+                : particles.addPolygon(p.x, p.v, p.w, p.orientation, p.body, p.density, p.material, id, p.flags);
+    } else {
+        i = particles.add(p.x, p.v, p.w, p.radius, p.density, p.material, id, p.flags);
+    }
+    particles.image[i] = p.image;
+    return i;
 }
 
 template void insertParticles<2>(const Scenario&, Particles<2>&, Rng);
 template void insertParticles<3>(const Scenario&, Particles<3>&, Rng);
+template class RandomPlacer<2>;
+template class RandomPlacer<3>;
+template void finishParticle<2>(const Scenario&, const InsertDef&, NewParticle<2>&, Rng&);
+template void finishParticle<3>(const Scenario&, const InsertDef&, NewParticle<3>&, Rng&);
+template void thermalVelocity<2>(const InsertDef&, NewParticle<2>&, Rng&);
+template void thermalVelocity<3>(const InsertDef&, NewParticle<3>&, Rng&);
+template std::size_t addToStore<2>(Particles<2>&, const NewParticle<2>&, std::uint64_t);
+template std::size_t addToStore<3>(Particles<3>&, const NewParticle<3>&, std::uint64_t);
 
 }  // namespace haet

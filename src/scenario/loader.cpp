@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "scenario/flow_loader.hpp"
 #include "scenario/table_reader.hpp"
 #include "scenario/text.hpp"
 #include "scenario/walls.hpp"
@@ -27,7 +28,7 @@ public:
 
     Scenario load() {
         root_.allowOnly({"name", "dimension", "method", "duration", "seed", "domain", "materials", "contact", "tdm",
-                         "edm", "haet", "walls", "insert", "output"});
+                         "edm", "haet", "walls", "insert", "outlet", "inlet", "output"});
         Scenario s;
         s.path = file_;
         readTop(s);
@@ -40,6 +41,7 @@ public:
         readWalls(s);
         readInserts(s);
         checkWalls(s);
+        readFlows(s);
         checkDiskLaw(s);
         readOutput(s);
         return s;
@@ -198,6 +200,7 @@ private:
         if (!needDiskLaw_) return;
         bool disks = s.inserts.empty();
         for (const InsertDef& in : s.inserts) disks = disks || in.shape == ShapeKind::Disk;
+        for (const InletDef& in : s.inlets) disks = disks || in.particles.shape == ShapeKind::Disk;
         if (disks)
             child("contact").fail("duration", "the linear law needs a contact duration (or kn); neither is given");
     }
@@ -296,9 +299,45 @@ private:
         }
     }
 
+    /// [[outlet]] and [[inlet]] blocks (docs/scenario.md, "Outlets", "Inlets"): an inlet's particles are read as an
+    /// insert's (material, shape, sizes, region, velocities), its timing by loader::readInletFlow.
+    void readFlows(Scenario& s) const {
+        if (const toml::array* outlets = root_.arrayOfTables("outlet"))
+            for (std::size_t i = 0; i < outlets->size(); ++i)
+                s.outlets.push_back(loader::readOutlet(
+                    TableReader(*outlets->get(i)->as_table(), "outlet[" + std::to_string(i + 1) + "]", file_), dim_,
+                    s.duration));
+        const toml::array* inlets = root_.arrayOfTables("inlet");
+        for (std::size_t i = 0; inlets && i < inlets->size(); ++i) {
+            const TableReader r(*inlets->get(i)->as_table(), "inlet[" + std::to_string(i + 1) + "]", file_);
+            r.allowOnly({"name", "material", "region", "cylinder", "surface", "radius", "distribution", "velocity",
+                         "temperature", "rate", "mass_rate", "start", "end", "interval", "shape", "polygon", "sides",
+                         "aspect", "orientation"});
+            InletDef in;
+            InsertDef& p = in.particles;
+            p.material = materialIndex(r, "material");
+            readShape(r, p);
+            if (p.shape == ShapeKind::Polygon && s.method != Method::Tdm)
+                r.fail("shape", "polygons need method = \"tdm\" (the event-driven engine handles disks and spheres)");
+            loader::readSizes(r, dim_, p);
+            p.velocity = r.vector("velocity", dim_).value_or(Vec3d{0, 0, 0});
+            p.temperature = r.number("temperature").value_or(0.0);
+            if (!(p.temperature >= 0)) r.fail("temperature", "must be >= 0");
+            if (r.has("cylinder"))
+                loader::readCylinder(r, dim_, domain_, p);
+            else if (!r.has("surface"))
+                readRegion(r, p);
+            loader::readInletFlow(r, dim_, s, in);
+            if (r.has("surface")) loader::readSurface(r, dim_, domain_, in);
+            s.inlets.push_back(std::move(in));
+        }
+        loader::nameFlows(s);
+    }
+
     InsertDef readInsert(const TableReader& r) const {
-        r.allowOnly({"arrangement", "count", "radius", "material", "region", "spacing", "velocity", "temperature",
-                     "frozen", "file", "format", "frozen_types", "shape", "polygon", "sides", "aspect", "orientation"});
+        r.allowOnly({"arrangement", "count", "radius", "distribution", "material", "region", "spacing", "velocity",
+                     "temperature", "frozen", "file", "format", "frozen_types", "shape", "polygon", "sides", "aspect",
+                     "orientation"});
         InsertDef in;
         in.pos = r.tablePos();
         in.arrangement = r.choice<Arrangement>("arrangement", {{"random", Arrangement::Random},
@@ -313,7 +352,7 @@ private:
 
         if (in.arrangement == Arrangement::File) {
             const std::string why = "not used with arrangement = \"file\" (the file gives it per particle)";
-            for (const char* key : {"count", "radius", "region", "spacing", "velocity", "temperature"})
+            for (const char* key : {"count", "radius", "distribution", "region", "spacing", "velocity", "temperature"})
                 r.forbid(key, why);
             const std::string name = r.requiredString("file");
             if (name.empty()) r.fail("file", "must not be empty");
@@ -342,7 +381,7 @@ private:
         if (*count <= 0) r.fail("count", "must be > 0");
         in.count = std::size_t(*count);
 
-        readRadius(r, in);
+        loader::readSizes(r, dim_, in);
         readRegion(r, in);
 
         if (in.arrangement == Arrangement::Lattice) {
@@ -424,21 +463,6 @@ private:
             } else {
                 r.fail("orientation", "expected a number (radians) or \"random\"");
             }
-        }
-    }
-
-    void readRadius(const TableReader& r, InsertDef& in) const {
-        const toml::node* n = r.table().get("radius");
-        if (!n) r.fail("radius", "is required");
-        if (n->is_array()) {
-            const auto range = r.vector("radius", 2);  // "expected an array of 2 numbers" when malformed
-            in.radiusMin = (*range)[0];
-            in.radiusMax = (*range)[1];
-            if (!(in.radiusMin > 0 && in.radiusMin <= in.radiusMax)) r.fail("radius", "must satisfy 0 < min <= max");
-        } else {
-            if (!n->is_number()) r.fail("radius", "expected a number or an array [min, max] of 2 numbers");
-            in.radiusMin = in.radiusMax = *r.number("radius");
-            if (!(in.radiusMin > 0)) r.fail("radius", "must be > 0");
         }
     }
 

@@ -1,6 +1,7 @@
 #pragma once
-// The scenario loader's reader of one TOML table (scenario/loader.cpp, scenario/walls.cpp): typed values with the
-// dotted key path and the line of each, so that every error is "file:line: key: what is wrong".
+// The scenario loader's reader of one TOML table (scenario/loader.cpp, scenario/walls.cpp,
+// scenario/flow_loader.cpp): typed values with the dotted key path and the line of each, so that every error is
+// "file:line: key: what is wrong".
 #include <toml++/toml.h>
 
 #include <algorithm>

@@ -33,6 +33,40 @@ std::vector<MaterialStats> materialStats(const Particles<D>& p, int nMaterials) 
     return st;
 }
 
+/// A material that only inlets bring (none of it at the start) takes its statistics from the inlets' size
+/// distributions, so that the laws that depend on sizes and masses (Hertz's contact duration, the polygon step)
+/// see the particles that will come. Materials present at the start keep theirs.
+template <int D>
+void inletStats(const Scenario& sc, std::vector<MaterialStats>& stats) {
+    std::vector<std::size_t> inlets(stats.size(), 0);
+    for (const InletDef& in : sc.inlets) {
+        const InsertDef& p = in.particles;
+        MaterialStats& s = stats[std::size_t(p.material)];
+        if (s.count > 0 && inlets[std::size_t(p.material)] == 0) continue;
+        const double density = sc.materials[std::size_t(p.material)].density;
+        const double mean = 0.5 * summarize(p.size, D).meanByNumber;
+        const double mMin = density * Particles<D>::volumeOf(p.radiusMin);
+        const double n = double(inlets[std::size_t(p.material)]++);
+        s.meanRadius = (s.meanRadius * n + mean) / (n + 1);
+        s.meanMass = (s.meanMass * n + density * Particles<D>::volumeOf(mean)) / (n + 1);
+        s.minRadius = n > 0 ? std::min(s.minRadius, p.radiusMin) : p.radiusMin;
+        s.minMass = n > 0 ? std::min(s.minMass, mMin) : mMin;
+        s.count = std::max<std::size_t>(s.count, 1);
+        if (p.shape == ShapeKind::Polygon) {
+            // A lower bound of the lightest polygon's area, r^2 times: the regular one of the fewest sides, the
+            // rectangle of the aspect, a triangle squeezed by the largest stretch.
+            const double pi = 3.14159265358979323846, a = p.aspect;
+            const double factor =
+                p.polygon == PolygonKind::Regular
+                    ? 0.5 * p.sidesMin * std::sin(2 * pi / p.sidesMin)
+                    : (p.polygon == PolygonKind::Rectangle ? 4 * a / (1 + a * a) : 0.75 * std::sqrt(3.0) / a);
+            const double mPoly = density * factor * p.radiusMin * p.radiusMin;
+            s.minPolygonMass = s.polygons ? std::min(s.minPolygonMass, mPoly) : mPoly;
+            s.polygons = std::max<std::size_t>(s.polygons, 1);
+        }
+    }
+}
+
 template <int D>
 ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialStats>& stats) {
     const std::vector<MaterialProps> props(sc.materials.begin(), sc.materials.end());
@@ -64,7 +98,9 @@ World<D> buildWorld(const Scenario& sc) {
         }
     }
     insertParticles<D>(sc, w.particles, Rng(sc.seed, RngStream::Insert));
-    w.contact = buildContactSetup<D>(sc, materialStats(w.particles, static_cast<int>(sc.materials.size())));
+    std::vector<MaterialStats> stats = materialStats(w.particles, static_cast<int>(sc.materials.size()));
+    inletStats<D>(sc, stats);
+    w.contact = buildContactSetup<D>(sc, stats);
     return w;
 }
 
@@ -103,6 +139,7 @@ TdmSettings tdmSettings(const Scenario& sc, const World<D>& w, std::string* dtNo
     if (dtNote) *dtNote = note.str();
     double dmax = 0;
     for (double r : w.particles.radius) dmax = std::max(dmax, 2 * r);
+    for (const InletDef& in : sc.inlets) dmax = std::max(dmax, 2 * in.particles.radiusMax);  // particles to come
     // Default skin: a tenth of the largest diameter (LAMMPS granular inputs typically use 0.1 d).
     s.skin = sc.tdm.skin ? *sc.tdm.skin : (dmax > 0 ? 0.1 * dmax : 1e-3);
     return s;

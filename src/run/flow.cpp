@@ -1,0 +1,284 @@
+#include "run/flow.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <ostream>
+
+namespace haet {
+
+namespace {
+
+constexpr double kNoTime = std::numeric_limits<double>::infinity();
+
+/// Draws of positions per due particle and batch before it waits for the next batch (LIGGGHTS's insertion
+/// commands try a fixed number of times too): a crowded region costs a bounded amount per batch.
+constexpr std::uint64_t kTriesPerParticle = 200;
+
+template <int D>
+Vec<D> toVec(const Vec3d& a) {
+    Vec<D> v;
+    for (int k = 0; k < D; ++k) v[k] = a[std::size_t(k)];
+    return v;
+}
+
+void describeSize(const std::string& who, const SizeDistribution& s, int dim, std::ostream& out) {
+    const SizeSummary m = summarize(s, dim);
+    out << fmt::format("sizes      {}: {}\n", who, describeSizes(s));
+    out << fmt::format(
+        "           diameter mean {:.4g} m by number, {:.4g} m by mass; d50 {:.4g} m by number, {:.4g} m by mass\n",
+        m.meanByNumber, m.meanByMass, m.d50ByNumber, m.d50ByMass);
+}
+
+}  // namespace
+
+template <int D>
+Flow<D>::Flow(const Scenario& sc, const World<D>& world, double dt) : sc_(sc), dt_(dt) {
+    const Particles<D>& p = world.particles;
+    initial_ = p.size();
+    for (std::size_t i = 0; i < p.size(); ++i) nextId_ = std::max(nextId_, p.id[i] + 1);
+    time_ = world.time;
+    for (std::size_t k = 0; k < sc.inlets.size(); ++k) {
+        const InletDef& d = sc.inlets[k];
+        inlets_.push_back(Inlet{
+            &d, Rng(sc.seed, static_cast<std::uint64_t>(RngStream::InletFirst) + k), d.start, {}, {}, 0, 0, 0, {}});
+    }
+    for (const OutletDef& d : sc.outlets) {
+        lazyInterval_ = std::min(lazyInterval_, d.interval);
+        outlets_.push_back(Outlet{&d, {}});
+    }
+    nextLazy_ = outlets_.empty() ? kNoTime : world.time + lazyInterval_;
+}
+
+template <int D>
+double Flow<D>::nextTime() const {
+    double t = nextLazy_;
+    if (!outlets_.empty() && dt_ > 0) t = std::min(t, time_ + dt_);
+    for (const Inlet& in : inlets_) t = std::min(t, in.next);
+    return t;
+}
+
+template <int D>
+bool Flow<D>::inside(const OutletDef& o, const Vec<D>& x) const {
+    if (o.kind == OutletKind::HalfSpace) {
+        double s = 0;
+        for (int k = 0; k < D; ++k) s += (x[k] - o.point[std::size_t(k)]) * o.normal[std::size_t(k)];
+        return s >= 0;
+    }
+    for (int k = 0; k < D; ++k)
+        if (x[k] < o.lo[std::size_t(k)] || x[k] > o.hi[std::size_t(k)]) return false;
+    return true;
+}
+
+template <int D>
+void Flow<D>::act(World<D>& world, FlowHost<D>& host, double tol) {
+    Particles<D>& p = world.particles;
+    const double t = world.time;
+    time_ = t;
+    bool synced = false;
+    auto sync = [&] {
+        if (!synced) host.synchronise();
+        synced = true;
+    };
+    if (!outlets_.empty()) {
+        // Time-driven particles after every step, event-driven ones at the outlets' interval.
+        const bool lazy = nextLazy_ <= t + tol;
+        if (lazy) {
+            sync();
+            while (nextLazy_ <= t + tol) nextLazy_ += lazyInterval_;
+        }
+        const std::size_t n = p.size(), end = lazy ? n : std::min(n, dt_ > 0 ? host.eager() : 0);
+        std::vector<std::uint32_t> which;
+        for (std::size_t i = 0; i < end; ++i) {
+            if (p.frozen(i)) continue;  // a fixture never leaves
+            for (Outlet& o : outlets_) {
+                if (!inside(*o.def, p.x[i])) continue;
+                which.push_back(static_cast<std::uint32_t>(i));
+                ++o.out.particles;
+                o.out.mass += p.mass[i];
+                break;
+            }
+        }
+        if (!which.empty()) host.remove(which);
+    }
+    const std::size_t first = p.size();
+    for (Inlet& in : inlets_) {
+        if (in.next > t + tol) continue;
+        sync();
+        batch(world, in);
+    }
+    if (p.size() > first) host.added(first);
+}
+
+template <int D>
+void Flow<D>::batch(World<D>& world, Inlet& in) {
+    const InletDef& def = *in.def;
+    const InsertDef& d = def.particles;
+    const double t = world.time;
+    const double elapsed = std::min(t, def.end) - def.start;
+    // What fell due by now: floor(rate x elapsed) particles, or particles while the mass drawn stays within half a
+    // particle of mass_rate x elapsed. Each particle is drawn (size, shape) before it is due, and waits drawn.
+    for (;;) {
+        if (!in.drawn) {
+            NewParticle<D> q;
+            q.radius = d.size.sample(in.rng);
+            finishParticle(sc_, d, q, in.rng);
+            in.drawn = q;
+        }
+        const bool due = def.rate > 0 ? double(in.drawnCount) < std::floor(def.rate * elapsed * (1 + 1e-12))
+                                      : in.drawnMass + 0.5 * in.drawn->mass() <= def.massRate * elapsed;
+        if (!due) break;
+        in.drawnMass += in.drawn->mass();
+        ++in.drawnCount;
+        in.pending.push_back(std::move(*in.drawn));
+        in.drawn.reset();
+    }
+    if (!in.pending.empty()) {
+        RandomPlacer<D> placer(sc_, d, world.particles, in.pending.size());
+        std::vector<NewParticle<D>> left;
+        for (NewParticle<D>& q : in.pending) {
+            if (!placer.place(q, in.rng, kTriesPerParticle)) {
+                left.push_back(std::move(q));  // the shortfall: tried again at the next batch
+                continue;
+            }
+            thermalVelocity(d, q, in.rng);
+            addToStore(world.particles, q, nextId_++);
+            ++in.in.particles;
+            in.in.mass += q.mass();
+        }
+        in.pending.swap(left);
+    }
+    // Batches at start + j interval, one at `end` itself, and after it only while a shortfall waits.
+    ++in.batches;
+    const double next = def.start + double(in.batches) * def.interval;
+    if (t < def.end)
+        in.next = std::min(next, def.end);
+    else
+        in.next = in.pending.empty() ? kNoTime : t + def.interval;
+}
+
+template <int D>
+std::vector<std::string> Flow<D>::columns() const {
+    std::vector<std::string> c;
+    for (const Inlet& in : inlets_)
+        for (const char* what : {"_particles", "_mass", "_shortfall"}) c.push_back(in.def->name + what);
+    for (const Outlet& o : outlets_)
+        for (const char* what : {"_particles", "_mass"}) c.push_back(o.def->name + what);
+    return c;
+}
+
+template <int D>
+std::vector<std::optional<double>> Flow<D>::row() const {
+    std::vector<std::optional<double>> r;
+    for (const Inlet& in : inlets_) {
+        r.push_back(double(in.in.particles));
+        r.push_back(in.in.mass);
+        r.push_back(double(in.pending.size()));
+    }
+    for (const Outlet& o : outlets_) {
+        r.push_back(double(o.out.particles));
+        r.push_back(o.out.mass);
+    }
+    return r;
+}
+
+template <int D>
+void Flow<D>::describe(JsonObject& j) const {
+    if (empty()) return;
+    JsonObject f;
+    f.add("initial_particles", initial_);
+    std::uint64_t added = 0, removed = 0;
+    JsonObject inlets, outlets;
+    for (const Inlet& in : inlets_) {
+        JsonObject o;
+        o.add("particles", in.in.particles);
+        o.add("mass", in.in.mass);
+        o.add("shortfall", static_cast<std::uint64_t>(in.pending.size()));
+        inlets.add(in.def->name, o);
+        added += in.in.particles;
+    }
+    for (const Outlet& out : outlets_) {
+        JsonObject o;
+        o.add("particles", out.out.particles);
+        o.add("mass", out.out.mass);
+        outlets.add(out.def->name, o);
+        removed += out.out.particles;
+    }
+    f.add("inserted", added);
+    f.add("removed", removed);
+    f.add("inlets", inlets);
+    f.add("outlets", outlets);
+    j.add("flows", f);
+}
+
+template <int D>
+void dropParticles(Particles<D>& p, const std::vector<std::uint32_t>& which) {
+    for (auto it = which.rbegin(); it != which.rend(); ++it) {
+        p.swapEntries(*it, p.size() - 1);
+        p.popBack();
+    }
+}
+
+template <int D>
+void removeTimeDriven(World<D>& w, TdmEngine<D>& eng, const std::vector<std::uint32_t>& which) {
+    Particles<D>& p = w.particles;
+    std::vector<std::uint32_t> from(p.size());
+    for (std::size_t k = 0; k < from.size(); ++k) from[k] = static_cast<std::uint32_t>(k);
+    // Highest index first: the last particle, which takes a removed one's place, is never one still to remove.
+    for (auto it = which.rbegin(); it != which.rend(); ++it) {
+        const std::size_t last = p.size() - 1;
+        p.swapEntries(*it, last);
+        from[*it] = from[last];
+        from.pop_back();
+        p.popBack();
+    }
+    eng.remap(from);
+}
+
+template <int D>
+void addTimeDriven(World<D>& w, TdmEngine<D>& eng, std::size_t first) {
+    std::vector<std::uint32_t> from(w.particles.size(), TdmEngine<D>::kFresh);
+    for (std::size_t k = 0; k < first; ++k) from[k] = static_cast<std::uint32_t>(k);
+    eng.remap(from);
+}
+
+template void dropParticles<2>(Particles<2>&, const std::vector<std::uint32_t>&);
+template void dropParticles<3>(Particles<3>&, const std::vector<std::uint32_t>&);
+template void removeTimeDriven<2>(World<2>&, TdmEngine<2>&, const std::vector<std::uint32_t>&);
+template void removeTimeDriven<3>(World<3>&, TdmEngine<3>&, const std::vector<std::uint32_t>&);
+template void addTimeDriven<2>(World<2>&, TdmEngine<2>&, std::size_t);
+template void addTimeDriven<3>(World<3>&, TdmEngine<3>&, std::size_t);
+
+double inletRadiusBound(const Scenario& sc) {
+    double r = 0;
+    for (const InletDef& in : sc.inlets) r = std::max(r, in.particles.radiusMax);
+    return r;
+}
+
+void describeFlows(const Scenario& sc, std::ostream& out) {
+    for (std::size_t k = 0; k < sc.inserts.size(); ++k)
+        if (sc.inserts[k].arrangement != Arrangement::File)
+            describeSize("insert[" + std::to_string(k + 1) + "]", sc.inserts[k].size, sc.dimension, out);
+    for (const InletDef& in : sc.inlets) {
+        const InsertDef& p = in.particles;
+        const char* where = p.slab ? (p.slabRound ? "through a disc"
+                                                  : (sc.dimension == 2 ? "through a segment" : "through a rectangle"))
+                                   : (p.cylinder ? "in a cylinder" : "in a box");
+        out << fmt::format(
+            "inlet      {}: {} {} from {:.4g} s to {:.4g} s, a batch every {:.4g} s (docs/physics.md K.3)\n", in.name,
+            in.rate > 0 ? fmt::format("{:.4g} particles/s", in.rate) : fmt::format("{:.4g} kg/s", in.massRate), where,
+            in.start, in.end, in.interval);
+        describeSize("inlet " + in.name, in.particles.size, sc.dimension, out);
+    }
+    for (const OutletDef& o : sc.outlets)
+        out << fmt::format(
+            "outlet     {}: {}; time-driven particles checked every step, event-driven ones every {:.4g} s\n", o.name,
+            o.kind == OutletKind::Box ? "box" : "half-space beyond a plane", o.interval);
+}
+
+template class Flow<2>;
+template class Flow<3>;
+
+}  // namespace haet
