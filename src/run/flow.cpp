@@ -165,22 +165,26 @@ std::vector<std::string> Flow<D>::columns() const {
     for (const Inlet& in : inlets_)
         for (const char* what : {"_particles", "_mass", "_shortfall"}) c.push_back(in.def->name + what);
     for (const Outlet& o : outlets_)
-        for (const char* what : {"_particles", "_mass"}) c.push_back(o.def->name + what);
+        for (const char* what : {"_particles", "_mass", "_rate"}) c.push_back(o.def->name + what);
     return c;
 }
 
 template <int D>
-std::vector<std::optional<double>> Flow<D>::row() const {
+std::vector<std::optional<double>> Flow<D>::row(double time) {
     std::vector<std::optional<double>> r;
     for (const Inlet& in : inlets_) {
         r.push_back(double(in.in.particles));
         r.push_back(in.in.mass);
         r.push_back(double(in.pending.size()));
     }
-    for (const Outlet& o : outlets_) {
+    const bool first = !(time > rowTime_);  // the first row (NaN before) has no interval: no rate
+    for (Outlet& o : outlets_) {
         r.push_back(double(o.out.particles));
         r.push_back(o.out.mass);
+        r.push_back(first ? std::nullopt : std::optional<double>((o.out.mass - o.massAtRow) / (time - rowTime_)));
+        o.massAtRow = o.out.mass;
     }
+    rowTime_ = time;
     return r;
 }
 

@@ -54,9 +54,11 @@ public:
     /// Does what is due at world.time (to within tol [s]): outlet checks, inlet batches.
     void act(World<D>& world, FlowHost<D>& host, double tol);
 
-    /// series.csv: per inlet NAME_particles, NAME_mass, NAME_shortfall; per outlet NAME_particles, NAME_mass.
+    /// series.csv: per inlet NAME_particles, NAME_mass, NAME_shortfall; per outlet NAME_particles, NAME_mass,
+    /// NAME_rate (the mass it removed since the row before over the time since then [kg/s]: a discharge rate).
     std::vector<std::string> columns() const;
-    std::vector<std::optional<double>> row() const;
+    /// The row at `time` [s]; rows come in time order.
+    std::vector<std::optional<double>> row(double time);
     /// run.json: "flows": the initial count and each inlet's and outlet's totals.
     void describe(JsonObject& j) const;
 
@@ -75,13 +77,15 @@ private:
     struct Outlet {
         const OutletDef* def;
         FlowCount out;
+        double massAtRow = 0;  // out.mass at the last row [kg]
     };
     bool inside(const OutletDef& o, const Vec<D>& x) const;
     void batch(World<D>& world, Inlet& in);
 
     const Scenario& sc_;
     double dt_;
-    double time_ = 0;  // world.time at the last act() [s]
+    double time_ = 0;                                            // world.time at the last act() [s]
+    double rowTime_ = std::numeric_limits<double>::quiet_NaN();  // time of the last series row [s]
     std::uint64_t nextId_ = 0;
     std::uint64_t initial_ = 0;
     double lazyInterval_ = std::numeric_limits<double>::infinity();  // the smallest of the outlets' intervals [s]

@@ -464,7 +464,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                                                   eng->maxOverlapRatio(),
                                                   pressure};
         for (auto& v : eng->extraRow()) row.push_back(v);
-        for (auto& v : flow.row()) row.push_back(v);
+        for (auto& v : flow.row(world.time)) row.push_back(v);
         series.row(row);
     };
 

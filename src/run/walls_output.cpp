@@ -219,8 +219,9 @@ void describeWalls(const World<D>& w, std::ostream& out) {
         std::string kind;
         switch (s.kind) {
             case SurfaceKind::Mesh:
-                kind = fmt::format("{} of {} {} ({} vertices)", D == 2 ? "polyline" : "mesh", s.elements.size(),
-                                   D == 2 ? "segments" : "triangles", s.vertices.size());
+                kind =
+                    fmt::format("{} of {} {}{} ({} vertices)", D == 2 ? "polyline" : "mesh", s.elements.size(),
+                                D == 2 ? "segment" : "triangle", s.elements.size() == 1 ? "" : "s", s.vertices.size());
                 break;
             case SurfaceKind::Arc:
                 kind = s.fullCircle() ? fmt::format("circle of radius {:.4g}", s.radius)
