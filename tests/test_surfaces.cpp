@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -232,102 +233,84 @@ TEST(SurfaceList, CellsMatchBruteForce) {
     EXPECT_GT(fast.size(), 300u);
 }
 
-/// A ball started at rest on an incline rolls down it; the incline is a plane wall or a mesh of many triangles in the
-/// same plane. Returns the centre's positions every 500 steps.
-std::vector<Vec<3>> rollDown(bool mesh) {
-    const double theta = 20 * kPi / 180, tc = 1e-3, a = 0.005;
-    Scenario sc = testing::linearScenario(3, 0.5, tc, 0.5, TangentialLaw::Spring);
-    World<3> w;
-    w.domain = testing::openBox<3>(0.5);
-    w.domain.gravity = v3(0, 0, -9.81);
-    const Vec<3> n = v3(-std::sin(theta), 0, std::cos(theta));  // incline through the origin
-    const Vec<3> t = v3(std::cos(theta), 0, std::sin(theta));   // uphill
-    const Vec<3> b = v3(0, 1, 0);
-    w.particles.add(n * (a * 0.999) + t * 0.2, Vec<3>::zero(), Ang<3>::zero(), a, 2500, 0, 0);
-    if (mesh) {
-        // The mesh of flatMesh in the incline's frame: 60 x 60 cells over 0.6 m x 0.6 m.
-        SurfaceWall<3> flat = flatMesh(0.6, 60, 0.0, 9);
+/// A ball (disk) started at rest on an incline through the origin rolls down it: the incline is a plane wall, or the
+/// wall of any shape that surface(n, t) makes in the same plane (n its normal, t uphill). Returns the centre's
+/// positions every 500 steps.
+template <int D, class Surface>
+std::vector<Vec<D>> rollDown(double thetaDeg, double a, double density, Surface&& surface) {
+    const double theta = thetaDeg * kPi / 180, tc = 1e-3;
+    Scenario sc = testing::linearScenario(D, 0.5, tc, 0.5, TangentialLaw::Spring);
+    World<D> w;
+    w.domain = testing::openBox<D>(0.5);
+    w.domain.gravity[D - 1] = -9.81;
+    Vec<D> n, t;
+    n[0] = -std::sin(theta);
+    n[D - 1] = std::cos(theta);
+    t[0] = std::cos(theta);
+    t[D - 1] = std::sin(theta);
+    w.particles.add(n * (a * 0.999) + t * 0.2, Vec<D>::zero(), Ang<D>::zero(), a, density, 0, 0);
+    if (std::optional<SurfaceWall<D>> s = surface(n, t))
+        w.surfaces.push_back(*s);
+    else
+        w.walls.push_back(Wall<D>::plane(Vec<D>::zero(), n, Vec<D>::zero(), 0));
+    w.contact = buildContactSetup<D>(sc, testing::statsOf(w.particles, 1));
+    TdmSettings s;
+    s.dt = tc / 50;
+    s.skin = a;
+    s.sortEvery = 0;
+    TdmEngine<D> eng(w, s);
+    std::vector<Vec<D>> path;
+    for (int k = 0; k < 30; ++k) {
+        for (int q = 0; q < 500; ++q) eng.step();
+        path.push_back(w.particles.x[0]);
+    }
+    return path;
+}
+
+/// The largest distance between two paths relative to the distance travelled on the first, which must exceed `min`.
+template <int D>
+void expectSamePath(const std::vector<Vec<D>>& plane, const std::vector<Vec<D>>& other, double min) {
+    ASSERT_EQ(plane.size(), other.size());
+    double travelled = 0;
+    for (std::size_t k = 0; k < plane.size(); ++k) {
+        travelled = norm(plane[k] - plane.front());
+        EXPECT_LE(norm(other[k] - plane[k]), 1e-9 * std::max(travelled, 0.01)) << "sample " << k;
+    }
+    EXPECT_GT(travelled, min);
+}
+
+TEST(SurfaceRun, BallOnMeshInclineFollowsThePlanePath) {
+    auto none = [](const Vec<3>&, const Vec<3>&) { return std::optional<SurfaceWall<3>>(); };
+    auto mesh = [](const Vec<3>&, const Vec<3>& t) {
+        // flatMesh in the incline's frame: 60 x 60 cells over 0.6 m x 0.6 m.
+        const SurfaceWall<3> flat = flatMesh(0.6, 60, 0.0, 9);
         std::vector<std::array<Vec<3>, 3>> tris;
         for (const auto& el : flat.elements) {
             std::array<Vec<3>, 3> tri;
             for (int k = 0; k < 3; ++k) {
                 const Vec<3>& q = flat.vertices[el[k]];
-                tri[k] = t * (q[0] - 0.3) + b * (q[1] - 0.3);
+                tri[k] = t * (q[0] - 0.3) + v3(0, 1, 0) * (q[1] - 0.3);
             }
             tris.push_back(tri);
         }
         SurfaceWall<3> inc;
         buildMesh<3>(inc, tris);
-        w.surfaces.push_back(inc);
-    } else {
-        w.walls.push_back(Wall<3>::plane(Vec<3>::zero(), n, Vec<3>::zero(), 0));
-    }
-    w.contact = buildContactSetup<3>(sc, testing::statsOf(w.particles, 1));
-    TdmSettings s;
-    s.dt = tc / 50;
-    s.skin = a;
-    s.sortEvery = 0;
-    TdmEngine<3> eng(w, s);
-    std::vector<Vec<3>> path;
-    for (int k = 0; k < 30; ++k) {
-        for (int q = 0; q < 500; ++q) eng.step();
-        path.push_back(w.particles.x[0]);
-    }
-    return path;
+        return std::optional<SurfaceWall<3>>(inc);
+    };
+    // Over 0.1 m: across dozens of triangle edges.
+    expectSamePath(rollDown<3>(20, 0.005, 2500, none), rollDown<3>(20, 0.005, 2500, mesh), 0.1);
 }
 
-TEST(SurfaceRun, BallOnMeshInclineFollowsThePlanePath) {
-    const auto plane = rollDown(false), mesh = rollDown(true);
-    ASSERT_EQ(plane.size(), mesh.size());
-    const Vec<3> start = plane.front();
-    double travelled = 0;
-    for (std::size_t k = 0; k < plane.size(); ++k) {
-        travelled = norm(plane[k] - start);
-        EXPECT_LE(norm(mesh[k] - plane[k]), 1e-9 * std::max(travelled, 0.01)) << "sample " << k;
-    }
-    EXPECT_GT(travelled, 0.1);  // over 0.1 m: across dozens of triangle edges
-}
-
-/// A disk rolling down a 2D incline of plane or of collinear segments (every 2 mm a vertex).
-std::vector<Vec<2>> rollDown2d(bool segments) {
-    const double theta = 25 * kPi / 180, tc = 1e-3, a = 0.004;
-    Scenario sc = testing::linearScenario(2, 0.5, tc, 0.5, TangentialLaw::Spring);
-    World<2> w;
-    w.domain = testing::openBox<2>(0.5);
-    w.domain.gravity = Vec<2>{{0, -9.81}};
-    const Vec<2> n{{-std::sin(theta), std::cos(theta)}}, t{{std::cos(theta), std::sin(theta)}};
-    w.particles.add(n * (a * 0.999) + t * 0.2, Vec<2>::zero(), Ang<2>::zero(), a, 2.5, 0, 0);
-    if (segments) {
+TEST(SurfaceRun, DiskOnCollinearSegmentsFollowsThePlanePath) {
+    auto none = [](const Vec<2>&, const Vec<2>&) { return std::optional<SurfaceWall<2>>(); };
+    auto segments = [](const Vec<2>&, const Vec<2>& t) {  // a vertex every 2 mm
         std::vector<std::array<Vec<2>, 2>> segs;
         for (int k = 0; k < 150; ++k) segs.push_back({t * (-0.05 + 0.002 * k), t * (-0.05 + 0.002 * (k + 1))});
         SurfaceWall<2> line;
         buildMesh<2>(line, segs);
-        w.surfaces.push_back(line);
-    } else {
-        w.walls.push_back(Wall<2>::plane(Vec<2>::zero(), n, Vec<2>::zero(), 0));
-    }
-    w.contact = buildContactSetup<2>(sc, testing::statsOf(w.particles, 1));
-    TdmSettings s;
-    s.dt = tc / 50;
-    s.skin = a;
-    s.sortEvery = 0;
-    TdmEngine<2> eng(w, s);
-    std::vector<Vec<2>> path;
-    for (int k = 0; k < 30; ++k) {
-        for (int q = 0; q < 500; ++q) eng.step();
-        path.push_back(w.particles.x[0]);
-    }
-    return path;
-}
-
-TEST(SurfaceRun, DiskOnCollinearSegmentsFollowsThePlanePath) {
-    const auto plane = rollDown2d(false), segs = rollDown2d(true);
-    double travelled = 0;
-    for (std::size_t k = 0; k < plane.size(); ++k) {
-        travelled = norm(plane[k] - plane.front());
-        EXPECT_LE(norm(segs[k] - plane[k]), 1e-9 * std::max(travelled, 0.01)) << "sample " << k;
-    }
-    EXPECT_GT(travelled, 0.1);  // some 50 segment ends crossed
+        return std::optional<SurfaceWall<2>>(line);
+    };
+    expectSamePath(rollDown<2>(25, 0.004, 2.5, none), rollDown<2>(25, 0.004, 2.5, segments), 0.1);
 }
 
 TEST(SurfaceRun, RotatingDrumDragsItsParticleToTheWallSpeed) {

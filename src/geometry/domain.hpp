@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/vec.hpp"
+#include "geometry/motion.hpp"
 
 namespace haet {
 
@@ -73,16 +74,12 @@ struct Wall {
     bool oscillates() const { return frequency != 0; }
     Vec<D> pointAt(double t) const {
         Vec<D> p = point + velocity * t;
-        if (oscillates()) {
-            const double w = 2 * std::numbers::pi * frequency;
-            p += amplitude * (std::sin(w * t + phase) - std::sin(phase));
-        }
+        if (oscillates()) p += oscillationDisplacement(amplitude, frequency, phase, t);
         return p;
     }
     Vec<D> velocityAt(double t) const {
         if (!oscillates()) return velocity;
-        const double w = 2 * std::numbers::pi * frequency;
-        return velocity + amplitude * (w * std::cos(w * t + phase));
+        return velocity + oscillationVelocity(amplitude, frequency, phase, t);
     }
     /// Sets pointNow and velocityNow to time t: once before every force pass, which reads only them.
     void moveTo(double t) {

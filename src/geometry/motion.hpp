@@ -13,6 +13,19 @@
 
 namespace haet {
 
+/// The displacement A (sin(2 pi f t + phi) - sin phi) of an oscillation, zero at t = 0 [m], and its velocity [m/s]:
+/// the oscillation of planes (geometry/domain.hpp) and of every other wall (Motion below).
+template <int D>
+Vec<D> oscillationDisplacement(const Vec<D>& amplitude, double frequency, double phase, double t) {
+    const double w = 2 * std::numbers::pi * frequency;
+    return amplitude * (std::sin(w * t + phase) - std::sin(phase));
+}
+template <int D>
+Vec<D> oscillationVelocity(const Vec<D>& amplitude, double frequency, double phase, double t) {
+    const double w = 2 * std::numbers::pi * frequency;
+    return amplitude * (w * std::cos(w * t + phase));
+}
+
 /// A rotation matrix in D dimensions, applied as R b and R^T x.
 template <int D>
 struct Rotation {
@@ -99,16 +112,12 @@ struct Motion {
     /// Translation d(t) of the body (the centre of rotation moves with it) [m].
     Vec<D> displacement(double t) const {
         Vec<D> d = velocity * t;
-        if (oscillates()) {
-            const double w = 2 * std::numbers::pi * frequency;
-            d += amplitude * (std::sin(w * t + phase) - std::sin(phase));
-        }
+        if (oscillates()) d += oscillationDisplacement(amplitude, frequency, phase, t);
         return d;
     }
     Vec<D> translationVelocity(double t) const {
         if (!oscillates()) return velocity;
-        const double w = 2 * std::numbers::pi * frequency;
-        return velocity + amplitude * (w * std::cos(w * t + phase));
+        return velocity + oscillationVelocity(amplitude, frequency, phase, t);
     }
     Pose<D> at(double t) const {
         Pose<D> p;

@@ -206,35 +206,9 @@ void writeVtuPolygons(const std::filesystem::path& path, std::span<const double>
 }
 
 void writeVtpWalls(const std::filesystem::path& path, const std::vector<WallQuad>& quads) {
-    const std::size_t n = quads.size();
-    std::vector<double> xyz;
-    xyz.reserve(12 * n);
-    std::vector<std::int32_t> ids(n);
-    std::vector<std::int64_t> connectivity(4 * n), cellEnd(n);
-    for (std::size_t k = 0; k < n; ++k) {
-        for (const auto& corner : quads[k].corners) xyz.insert(xyz.end(), corner.begin(), corner.end());
-        ids[k] = quads[k].id;
-        for (std::size_t c = 0; c < 4; ++c) connectivity[4 * k + c] = static_cast<std::int64_t>(4 * k + c);
-        cellEnd[k] = static_cast<std::int64_t>(4 * k + 4);
-    }
-    AppendedArrays arrays;
-    std::string head = fileHead("PolyData");
-    head += "  <PolyData>\n";
-    head += fmt::format(
-        "    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
-        "NumberOfPolys=\"{}\">\n",
-        4 * n, n);
-    head += "      <CellData>\n" + arrays.tag("wall_id", VtkField::Int32, 1, n, arrays.keep(std::move(ids)), 8) +
-            "      </CellData>\n";
-    head += "      <Points>\n" + arrays.tag("Points", VtkField::Float64, 3, 4 * n, arrays.keep(std::move(xyz)), 8) +
-            "      </Points>\n";
-    head += "      <Polys>\n";
-    head += arrays.tag("connectivity", VtkField::Int64, 1, 4 * n, arrays.keep(std::move(connectivity)), 8);
-    head += arrays.tag("offsets", VtkField::Int64, 1, n, arrays.keep(std::move(cellEnd)), 8);
-    head += "      </Polys>\n";
-    head += "    </Piece>\n";
-    head += "  </PolyData>\n";
-    arrays.write(path, head);
+    WallShapes sh;
+    for (const WallQuad& q : quads) sh.add(q);
+    writeVtpShapes(path, sh);
 }
 
 void writeVtpShapes(const std::filesystem::path& path, const WallShapes& sh) {

@@ -10,11 +10,20 @@
 #include <vector>
 
 #include "contact/model.hpp"
+#include "core/vec.hpp"
 #include "scenario/distribution.hpp"
 
 namespace haet {
 
 using Vec3d = std::array<double, 3>;
+
+/// The first D components of a definition's vector (definitions keep three; a 2D scenario uses two).
+template <int D>
+Vec<D> toVec(const Vec3d& a) {
+    Vec<D> v;
+    for (int k = 0; k < D; ++k) v[k] = a[static_cast<std::size_t>(k)];
+    return v;
+}
 
 enum class Method { Tdm, Edm, Haet };
 enum class Arrangement { Lattice, Random, File };

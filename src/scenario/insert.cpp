@@ -90,13 +90,6 @@ std::vector<std::string> readLines(const std::filesystem::path& file, const std:
     return lines;
 }
 
-template <int D>
-Vec<D> toVec(const Vec3d& a) {
-    Vec<D> v;
-    for (int k = 0; k < D; ++k) v[k] = a[std::size_t(k)];
-    return v;
-}
-
 /// The polygon of an insert with shape = "polygon", circumradius r, drawn after the particle's position.
 template <int D>
 void makePolygon(const InsertDef& in, NewParticle<D>& p, Rng& rng) {

@@ -361,21 +361,14 @@ void checkWalls(const Scenario& s) {
 namespace {
 
 template <int D>
-Vec<D> vecOf(const Vec3d& a) {
-    Vec<D> v;
-    for (int k = 0; k < D; ++k) v[k] = a[std::size_t(k)];
-    return v;
-}
-
-template <int D>
 Motion<D> motionOf(const WallDef& w) {
     Motion<D> m;
-    m.velocity = vecOf<D>(w.velocity);
-    m.amplitude = vecOf<D>(w.amplitude);
+    m.velocity = toVec<D>(w.velocity);
+    m.amplitude = toVec<D>(w.amplitude);
     m.frequency = w.frequency;
     m.phase = w.phase;
-    m.centre = vecOf<D>(w.rotationCentre);
-    if constexpr (D == 3) m.axis = vecOf<3>(w.rotationAxis);
+    m.centre = toVec<D>(w.rotationCentre);
+    if constexpr (D == 3) m.axis = toVec<3>(w.rotationAxis);
     m.omega = w.omega;
     return m;
 }
@@ -385,10 +378,10 @@ Motion<D> motionOf(const WallDef& w) {
 template <int D>
 Wall<D> makePlane(const WallDef& wd) {
     Wall<D> wall;
-    wall.point = vecOf<D>(wd.point);
-    wall.normal = vecOf<D>(wd.normal);
-    wall.velocity = vecOf<D>(wd.velocity);
-    wall.amplitude = vecOf<D>(wd.amplitude);
+    wall.point = toVec<D>(wd.point);
+    wall.normal = toVec<D>(wd.normal);
+    wall.velocity = toVec<D>(wd.velocity);
+    wall.amplitude = toVec<D>(wd.amplitude);
     wall.frequency = wd.frequency;
     wall.phase = wd.phase;
     wall.material = wd.material;
@@ -410,15 +403,15 @@ SurfaceWall<D> makeSurfaceWall(const WallDef& wd) {
                 std::vector<std::array<Vec<2>, 2>> segs;
                 const std::size_t np = wd.points.size();
                 for (std::size_t q = 0; q + 1 < np; ++q)
-                    segs.push_back({vecOf<2>(wd.points[q]), vecOf<2>(wd.points[q + 1])});
-                if (wd.closed) segs.push_back({vecOf<2>(wd.points[np - 1]), vecOf<2>(wd.points[0])});
+                    segs.push_back({toVec<2>(wd.points[q]), toVec<2>(wd.points[q + 1])});
+                if (wd.closed) segs.push_back({toVec<2>(wd.points[np - 1]), toVec<2>(wd.points[0])});
                 buildMesh<2>(w, segs);
             }
             break;
         case WallType::Circle:
         case WallType::Arc:
             w.kind = SurfaceKind::Arc;
-            w.centre = vecOf<D>(wd.centre);
+            w.centre = toVec<D>(wd.centre);
             w.radius = wd.radius;
             w.angle0 = wd.angle0;
             w.angle1 = wd.angle1;
@@ -427,15 +420,15 @@ SurfaceWall<D> makeSurfaceWall(const WallDef& wd) {
         case WallType::Rectangle:
             if constexpr (D == 3) {
                 std::vector<std::array<Vec<3>, 3>> tris;
-                for (const auto& t : wd.triangles) tris.push_back({vecOf<3>(t[0]), vecOf<3>(t[1]), vecOf<3>(t[2])});
+                for (const auto& t : wd.triangles) tris.push_back({toVec<3>(t[0]), toVec<3>(t[1]), toVec<3>(t[2])});
                 buildMesh<3>(w, tris);
             }
             break;
         case WallType::Cylinder:
         case WallType::Cone:
             w.kind = SurfaceKind::Cylinder;
-            w.centre = vecOf<D>(wd.centre);
-            w.axis = vecOf<D>(wd.axis);
+            w.centre = toVec<D>(wd.centre);
+            w.axis = toVec<D>(wd.axis);
             w.radius = wd.radius;
             w.radius1 = wd.radiusTop;
             w.length = wd.length;
@@ -444,8 +437,8 @@ SurfaceWall<D> makeSurfaceWall(const WallDef& wd) {
             break;
         case WallType::Disc:
             w.kind = SurfaceKind::Disc;
-            w.centre = vecOf<D>(wd.centre);
-            w.axis = vecOf<D>(wd.normal);
+            w.centre = toVec<D>(wd.centre);
+            w.axis = toVec<D>(wd.normal);
             w.radius = wd.radius;
             break;
         case WallType::Plane:

@@ -74,13 +74,6 @@ ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialSta
 }
 
 template <int D>
-static Vec<D> toVec(const Vec3d& a) {
-    Vec<D> v;
-    for (int k = 0; k < D; ++k) v[k] = a[k];
-    return v;
-}
-
-template <int D>
 World<D> buildWorld(const Scenario& sc) {
     World<D> w;
     w.domain.lo = toVec<D>(sc.domain.lo);
