@@ -4,6 +4,7 @@
 // on the plane's path, its load, a square dragged by a rotating drum and by a conveyor segment, the energy of elastic
 // bounces under the potential law, and the example silo of polygons.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <random>
@@ -595,6 +596,38 @@ TEST(PolygonWallScenario, PolygonSiloRunsBriefly) {
     EXPECT_LT(eng.forceStats().maxOverlapRatio, 0.2);
     EXPECT_LT(eng.surfaceLoad(0).force[1] + eng.surfaceLoad(1).force[1], 0.0) << "the silo floor is pressed down";
     EXPECT_GT(eng.wallContacts(), 5u);
+}
+
+TEST(PolygonWallScenario, SiloBitIdenticalWithOneAndTwoThreads) {
+    // The polygon silo with 2400 polygons (the threaded pass runs from 2048 particles on), 1200 steps (the lowest
+    // reach the silo's floor): the same bits, wall loads included, with one thread and with two.
+    const Scenario sc = testing::exampleScenario(
+        "hopper2d_polygons.toml", {"insert[1].count=2400", "insert[1].region={ lo = [0.1, 0.3], hi = [0.3, 0.69] }"});
+    struct Out {
+        Particles<2> p;
+        V2 load;
+    };
+    auto run = [&](int threads) {
+        omp_set_num_threads(threads);
+        World<2> w = buildWorld<2>(sc);
+        TdmSettings s = tdmSettings<2>(sc, w);
+        s.sortEvery = 50;
+        TdmEngine<2> eng(w, s);
+        for (int k = 0; k < 1200; ++k) eng.step();
+        return Out{w.particles, eng.surfaceLoad(0).force + eng.surfaceLoad(1).force};
+    };
+    const int before = omp_get_max_threads();
+    const Out a = run(1), b = run(2);
+    omp_set_num_threads(before);
+    ASSERT_EQ(a.p.size(), 2400u);
+    ASSERT_EQ(a.p.id, b.p.id);
+    for (std::size_t i = 0; i < a.p.size(); ++i) {
+        ASSERT_EQ(a.p.x[i], b.p.x[i]) << i;
+        ASSERT_EQ(a.p.angle[i], b.p.angle[i]) << i;
+        ASSERT_EQ(a.p.w[i], b.p.w[i]) << i;
+    }
+    EXPECT_EQ(a.load, b.load);
+    EXPECT_LT(a.load[1], 0.0);
 }
 
 }  // namespace
