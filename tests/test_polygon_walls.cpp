@@ -499,6 +499,16 @@ TEST(PolygonWallRun, ConveyorSegmentCarriesASquare) {
     EXPECT_LT(std::abs(p.w[0][0]), 1e-3);
 }
 
+TEST(PolygonWallRun, DrumTorqueBalancesTheBedsWeight) {
+    // A bed of random polygons in a drum turning slowly (tests/polygon_util.hpp, drumBed): the torque the bed exerts on
+    // the drum about its axis balances the weight's torque, -g M x_cm, averaged over time.
+    const testing::DrumBed b = testing::drumBed(0, 0.6, 0.6);
+    record("drum_torque_over_weight_torque", b.torque / b.weightTorque - 1);
+    EXPECT_GT(b.particles, 50u);
+    EXPECT_GT(b.liftAngle, 5.0) << "the bed is carried up the side";
+    EXPECT_NEAR(b.torque, b.weightTorque, 0.02 * std::abs(b.weightTorque));
+}
+
 /// The energy (kinetic plus gravity's) of one elastic, frictionless polygon dropped with a spin onto walls, under
 /// the potential law (Gear5 at a quarter of the polygon step): its largest relative change over contact-free
 /// instants after `bounces` contacts, which must be there.
