@@ -502,7 +502,7 @@ TEST(PolygonWallRun, ConveyorSegmentCarriesASquare) {
 TEST(PolygonWallRun, DrumTorqueBalancesTheBedsWeight) {
     // A bed of random polygons in a drum turning slowly (tests/polygon_util.hpp, drumBed): the torque the bed exerts on
     // the drum about its axis balances the weight's torque, -g M x_cm, averaged over time.
-    const testing::DrumBed b = testing::drumBed(0, 0.6, 0.6);
+    const testing::DrumBed b = testing::drumBed(0, 0.4, 0.4);
     record("drum_torque_over_weight_torque", b.torque / b.weightTorque - 1);
     EXPECT_GT(b.particles, 50u);
     EXPECT_GT(b.liftAngle, 5.0) << "the bed is carried up the side";
