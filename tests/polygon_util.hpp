@@ -6,6 +6,7 @@
 
 #include "contact/setup.hpp"
 #include "core/rng.hpp"
+#include "geometry/surface.hpp"
 #include "physics_util.hpp"
 #include "polygon/geometry.hpp"
 #include "tdm/engine.hpp"
@@ -156,6 +157,87 @@ inline double pileAngle(const Scenario& sc) {
     double dmax = 0;
     for (double r : w.particles.radius) dmax = std::max(dmax, 2 * r);
     return reposeAngle(w.particles, dmax);
+}
+
+}  // namespace haet::testing
+
+namespace haet::testing {
+
+/// A bed of random polygons (about 55, circumradii 1.5-2 mm) in a drum of radius 3 cm turning at 1 rad/s under
+/// gravity: settled for `settle` seconds, then averaged over `average` seconds (every 20 steps). The drum is a circle,
+/// or (segments > 0) a closed polyline of that many segments inscribed in it.
+struct DrumBed {
+    double torque = 0;        ///< the bed's torque on the drum about its axis [N m]
+    double weightTorque = 0;  ///< -g M x_cm, the weight's torque about the axis [N m]
+    double liftAngle = 0;     ///< the bed's centre of mass from the lowest point, in the turning direction [degrees]
+    std::size_t particles = 0;
+};
+
+inline DrumBed drumBed(int segments, double settle, double average) {
+    const double Rd = 0.03, omega = 1.0, g = 9.81, pi = 3.14159265358979323846;
+    World<2> w;
+    w.domain = openBox<2>(0.05);
+    w.domain.gravity = Vec<2>{{0, -g}};
+    Rng rng(21, 3);
+    std::uint64_t id = 0;
+    for (double y = -Rd + 0.003; y < -0.004; y += 0.0042)
+        for (double x = -Rd; x < Rd; x += 0.0042)
+            if (x * x + y * y < (Rd - 0.0025) * (Rd - 0.0025))
+                w.particles.addPolygon(
+                    Vec<2>{{x, y}}, Vec<2>::zero(), Ang<2>::zero(), rng.uniform(0, 6.3),
+                    polygon::randomConvexPolygon(rng, 4 + int(rng.uniform() * 5), rng.uniform(0.0015, 0.002), 1.5, 0.0),
+                    2.0, 0, id++);
+    SurfaceWall<2> drum;
+    if (segments > 0) {
+        std::vector<std::array<Vec<2>, 2>> segs;
+        for (int k = 0; k < segments; ++k) {
+            const double a = 2 * pi * k / segments, b = 2 * pi * (k + 1) / segments;
+            segs.push_back(
+                {Vec<2>{{Rd * std::cos(a), Rd * std::sin(a)}}, Vec<2>{{Rd * std::cos(b), Rd * std::sin(b)}}});
+        }
+        buildMesh<2>(drum, segs);
+    } else {
+        drum.kind = SurfaceKind::Arc;
+        drum.radius = Rd;
+        drum.angle1 = 2 * pi;
+    }
+    drum.motion.omega = omega;
+    w.surfaces.push_back(drum);
+    Scenario sc = linearScenario(2, 0.3, 1e-3, 0.5, TangentialLaw::Spring);
+    sc.materials[0].young = 1000;
+    sc.materials[0].density = 2.0;
+    w.contact = buildContactSetup<2>(sc, materialStats(w.particles, 1));
+    TdmSettings s;
+    s.integrator = IntegratorKind::Gear5;
+    s.dt = w.contact.polygonStep;
+    s.skin = 0.0004;
+    s.sortEvery = 0;
+    TdmEngine<2> eng(w, s);
+    eng.advanceTo(settle);
+    const Particles<2>& p = w.particles;
+    DrumBed b;
+    double sx = 0, sy = 0, m = 0;
+    int n = 0;
+    while (w.time < settle + average) {
+        for (int k = 0; k < 20; ++k) eng.step();
+        double mx = 0, my = 0;
+        m = 0;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            mx += p.mass[i] * p.x[i][0];
+            my += p.mass[i] * p.x[i][1];
+            m += p.mass[i];
+        }
+        b.torque += eng.surfaceLoad(0).torque[0];
+        b.weightTorque += -g * mx;
+        sx += mx / m;
+        sy += my / m;
+        ++n;
+    }
+    b.torque /= n;
+    b.weightTorque /= n;
+    b.liftAngle = std::atan2(sx, -sy) * 180 / pi;  // counter-clockwise turning lifts the bed to the right (x > 0)
+    b.particles = p.size();
+    return b;
 }
 
 }  // namespace haet::testing

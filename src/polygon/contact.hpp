@@ -67,6 +67,7 @@ struct ContactForce {
     double torqueJ = 0;  ///< [N m]
     double fn = 0;       ///< normal force [N]
     V2 normal{};         ///< unit normal, from j to i
+    V2 point{};          ///< force point, in the frame of the bodies' x [m]
     double length = 0;   ///< characteristic length l [m] (overlap-area law; 0 for the potential law)
 };
 
@@ -169,6 +170,7 @@ template <class Law, bool kFriction>
     out.torqueJ = -cross2(rj, f);
     out.fn = fn;
     out.normal = n;
+    out.point = at;
     return out;
 }
 

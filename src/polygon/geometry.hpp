@@ -341,10 +341,11 @@ inline bool twoCrossingOverlap(const V2* P, int np, const V2* Q, int nq, const V
     return clipOverlap(P, np, Q, nq, nullptr, &pCentre, pRadius, &pShift);
 }
 
-/// Overlap of the disk of radius R centred at the origin with the convex counter-clockwise polygon Q (the first
-/// body is the polygon: chord and spin are those of Q's outline inside the circle). Exact: the overlap is cut
-/// into triangles (centre, edge piece inside the circle) and circular sectors (edge pieces outside).
-inline Overlap circlePolygonOverlap(double R, const V2* Q, int nq) {
+namespace detail {
+
+/// circlePolygonOverlap (below); kTagged: chord and spin only from the edges k with tags[k] == 0.
+template <bool kTagged>
+inline Overlap circleOverlap(double R, const V2* Q, int nq, const std::uint8_t* tags) {
     const double R2 = R * R;
     double area2 = 0;  // twice the area
     V2 mom2{};         // twice the first moment
@@ -375,8 +376,10 @@ inline Overlap circlePolygonOverlap(double R, const V2* Q, int nq) {
             const double cr = cross2(p0, p1);
             area2 += cr;
             mom2 += (p0 + p1) * (cr / 3.0);
-            chord += p1 - p0;
-            spinO += 0.5 * (norm2(p1) - norm2(p0));
+            if (!kTagged || tags[k] == 0) {
+                chord += p1 - p0;
+                spinO += 0.5 * (norm2(p1) - norm2(p0));
+            }
             boundaryInside = true;
             if (t1 < 1) sector(p1, b);
         } else {
@@ -391,6 +394,21 @@ inline Overlap circlePolygonOverlap(double R, const V2* Q, int nq) {
     o.chord = chord;
     o.spin = spinO - dot(o.centroid, chord);  // about C: sum (|b|^2 - |a|^2)/2 - C . sum (b - a)
     return o;
+}
+
+}  // namespace detail
+
+/// Overlap of the disk of radius R centred at the origin with the convex counter-clockwise polygon Q (the first
+/// body is the polygon: chord and spin are those of Q's outline inside the circle). Exact: the overlap is cut
+/// into triangles (centre, edge piece inside the circle) and circular sectors (edge pieces outside).
+inline Overlap circlePolygonOverlap(double R, const V2* Q, int nq) {
+    return detail::circleOverlap<false>(R, Q, nq, nullptr);
+}
+
+/// circlePolygonOverlap of a polygon Q cut out of a first body: chord and spin from the edges k with tags[k] == 0
+/// only (the first body's outline; the cuts are not), as the clipping tags them (wall_geometry.hpp).
+inline Overlap circlePolygonOverlapTagged(double R, const V2* Q, int nq, const std::uint8_t* tags) {
+    return detail::circleOverlap<true>(R, Q, nq, tags);
 }
 
 /// Overlap of the convex counter-clockwise polygon P with the half-plane { y : n . (y - p0) <= 0 } (the outside of

@@ -8,8 +8,9 @@
 // circles and the line of centres, then overlapped (convexOverlap: directly when the outlines cross twice, else by
 // clipping); a polygon and a disk use the exact circle-polygon overlap. All overlaps go through polygonContact
 // (polygon/contact.hpp), whose law (overlap area or potential) is a template parameter. Walls: half-plane overlap
-// for polygons, the disk wall kernel for disks. The pairs go one by one (kOneByOne): a polygon pair's work varies too
-// much for lanes.
+// for polygons against planes, the overlap with the solid behind each element against walls of any shape
+// (surface_kernel.hpp); the disk wall kernels for disks. The pairs go one by one (kOneByOne): a polygon pair's work
+// varies too much for lanes.
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "contact/setup.hpp"
 #include "polygon/contact.hpp"
 #include "polygon/geometry.hpp"
+#include "polygon/surface_kernel.hpp"
 #include "tdm/disk_kernel.hpp"
 #include "tdm/pair_pass.hpp"
 #include "tdm/wall_kernel.hpp"
@@ -180,7 +182,8 @@ public:
           history_(ctx.wallHistory),
           x_(ctx.p.x.data()),
           radius_(ctx.p.radius.data()),
-          shape_(ctx.p.shape.data()) {}
+          shape_(ctx.p.shape.data()),
+          surfaces_(ctx, ps.rotated) {}
 
     [[gnu::always_inline]] bool add(std::size_t i, std::size_t w, V2& f, Ang<2>& tq, double& worst) const {
         if (shape_[i] == kNoShape) return disk_.add(i, w, f, tq, worst);
@@ -196,11 +199,14 @@ public:
         return contact<false>(i, w, dist, hist, f, tq, worst, energy);
     }
 
-    /// Walls of any shape touch the disks among the polygons (a scene with polygons has none: the loader says so).
+    /// Walls of any shape: a disk by the disk kernel (tdm/surface_kernel.hpp), a polygon by its overlap with the solid
+    /// behind each element (surface_kernel.hpp).
     [[gnu::always_inline]] std::uint32_t addSurfaces(std::size_t i, V2& f, Ang<2>& tq, double& worst) const {
-        return shape_[i] == kNoShape ? disk_.addSurfaces(i, f, tq, worst) : 0;
+        return shape_[i] == kNoShape ? disk_.addSurfaces(i, f, tq, worst) : surfaces_.add(i, f, tq, worst);
     }
-    double surfaceEnergy(std::size_t i) const { return shape_[i] == kNoShape ? disk_.surfaceEnergy(i) : 0.0; }
+    double surfaceEnergy(std::size_t i) const {
+        return shape_[i] == kNoShape ? disk_.surfaceEnergy(i) : surfaces_.energy(i);
+    }
 
     /// The energy of wall w's contact with particle i at the current state [J]: a disk's by its law, a polygon's
     /// from its overlap (the spring copied, not changed).
@@ -260,6 +266,7 @@ private:
     const V2* x_;
     const double* radius_;
     const std::uint32_t* shape_;
+    PolygonSurfaceKernel<Law, Tangential::kHasHistory> surfaces_;
 };
 
 /// The kernel of the pair pass for scenes with polygons (tdm/pair_pass.hpp has the interface). Normal, Tangential:

@@ -338,8 +338,12 @@ void checkWalls(const Scenario& s) {
             throw ScenarioError(w.pos, key + ".oscillation",
                                 "an oscillating plane needs method = \"tdm\" (the event-driven engine predicts "
                                 "planes moving at a constant velocity)");
-        if (!w.isPlane() && polygons)
-            throw ScenarioError(w.pos, key + ".type", "polygon particles touch planes only: use plane walls");
+        // Polygons (2D) touch every 2D wall (docs/physics.md G.6); the 3D shapes are rejected for 2D scenes anyway.
+        const bool polygonWall = w.isPlane() || w.type == WallType::Segment || w.type == WallType::Polyline ||
+                                 w.type == WallType::Circle || w.type == WallType::Arc;
+        if (polygons && !polygonWall)
+            throw ScenarioError(w.pos, key + ".type",
+                                "polygon particles touch planes, segments, polylines, circles and arcs only");
         const bool moves = w.rotates() || w.frequency != 0 || norm3(w.velocity) > 0;
         if (!w.isPlane() && !moves) {
             Vec3d lo, hi;
