@@ -1,0 +1,495 @@
+// The event-driven engine with static mesh walls (docs/physics.md D.8, H.6): the fast engine against the brute-force
+// reference over long random runs with gravity (bit-identical event sequences, with cell crossings and with
+// neighbour shells), a flat mesh floor against its analytic plane, one collision where elements meet, the energy
+// books of a pure event-driven run, and the walls the engine refuses.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/rng.hpp"
+#include "io/stl.hpp"
+#include "test_edm_util.hpp"
+
+namespace haet {
+namespace {
+
+using testing::edmContact;
+
+template <int D>
+using Corners = std::array<Vec<D>, D>;
+
+/// A static mesh wall of the given elements (material 0).
+template <int D>
+SurfaceWall<D> meshWall(const std::vector<Corners<D>>& elements, int id) {
+    SurfaceWall<D> w;
+    w.id = id;
+    buildMesh<D>(w, elements);
+    return w;
+}
+
+/// The closed box [0, L]^D as elements: 2D four segments, 3D twelve triangles (each face cut along a diagonal).
+template <int D>
+std::vector<Corners<D>> boxElements(double L) {
+    std::vector<Corners<D>> out;
+    if constexpr (D == 2) {
+        const Vec<2> c[4] = {Vec<2>{{0, 0}}, Vec<2>{{L, 0}}, Vec<2>{{L, L}}, Vec<2>{{0, L}}};
+        for (int k = 0; k < 4; ++k) out.push_back({c[k], c[(k + 1) % 4]});
+    } else {
+        for (int axis = 0; axis < 3; ++axis)
+            for (const double side : {0.0, L}) {
+                const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+                Vec<3> q[4];
+                for (int k = 0; k < 4; ++k) {
+                    q[k][axis] = side;
+                    q[k][u] = (k == 1 || k == 2) ? L : 0;
+                    q[k][w] = (k >= 2) ? L : 0;
+                }
+                out.push_back({q[0], q[1], q[2]});
+                out.push_back({q[0], q[2], q[3]});
+            }
+    }
+    return out;
+}
+
+/// Distance from x to the nearest element of the world's meshes.
+template <int D>
+double meshDistance(const World<D>& w, const Vec<D>& x) {
+    double d = kNever;
+    for (const SurfaceWall<D>& s : w.surfaces)
+        for (std::size_t e = 0; e < s.elementCount(); ++e) d = std::min(d, s.distance(e, x));
+    return d;
+}
+
+struct MeshGas {
+    int n = 30;             ///< particles on the lattice (fewer: those too near an element are left out)
+    double L = 10;          ///< box edge [m]
+    int inner = 6;          ///< random elements inside the box
+    bool meshBox = true;    ///< the box's faces as one mesh wall (else planes)
+    bool periodic = false;  ///< all axes but the last periodic, a mesh floor and a plane ceiling
+    double e = 0.8, mu = 0.3, beta0 = 0.4;
+    std::uint64_t seed = 1;
+};
+
+/// Particles of radius 0.5 (0.3 to 0.5) on a lattice in the box, with random velocities, under a gravity with a
+/// component along every axis (so that edges and vertices are met at all angles), and mesh walls.
+template <int D>
+World<D> meshGas(const MeshGas& m) {
+    World<D> w;
+    w.contact = edmContact(m.e, m.mu, m.beta0);
+    Rng rng(m.seed, 7101);
+    const double L = m.L;
+    w.domain.lo = Vec<D>::zero();
+    w.domain.hi = Vec<D>::filled(L);
+    for (int k = 0; k < D; ++k) w.domain.periodic[k] = m.periodic && k < D - 1;
+    for (int k = 0; k < D; ++k) w.domain.gravity[k] = k == D - 1 ? -1.0 : 0.15 * (k + 1);
+    std::vector<Corners<D>> box;
+    if (m.periodic) {
+        // A floor of elements across the periodic axes, slightly wavy and continuous across the periodic faces
+        // (an even number of waves), and a plane ceiling.
+        const int cells = 4;
+        if constexpr (D == 2) {
+            for (int k = 0; k < cells; ++k) {
+                const double x0 = L * k / cells, x1 = L * (k + 1) / cells;
+                box.push_back({Vec<2>{{x0, 0.2 * (k % 2)}}, Vec<2>{{x1, 0.2 * ((k + 1) % 2)}}});
+            }
+        } else {
+            for (int i = 0; i < cells; ++i)
+                for (int j = 0; j < cells; ++j) {
+                    auto at = [&](int a, int b) { return Vec<3>{{L * a / cells, L * b / cells, 0.2 * ((a + b) % 2)}}; };
+                    box.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+                    box.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+                }
+        }
+        Vec<D> top = Vec<D>::zero(), down = Vec<D>::zero();
+        top[D - 1] = L;
+        down[D - 1] = -1;
+        w.walls.push_back(Wall<D>::plane(top, down, Vec<D>::zero(), 0));
+    } else if (m.meshBox) {
+        box = boxElements<D>(L);
+    } else {
+        for (int k = 0; k < D; ++k) {
+            Vec<D> n = Vec<D>::zero();
+            n[k] = 1;
+            w.walls.push_back(Wall<D>::plane(Vec<D>::zero(), n, Vec<D>::zero(), 0));
+            w.walls.push_back(Wall<D>::plane(Vec<D>::filled(L), n * -1.0, Vec<D>::zero(), 0));
+        }
+    }
+    if (!box.empty()) w.surfaces.push_back(meshWall<D>(box, 0));
+    std::vector<Corners<D>> inner;
+    for (int q = 0; q < m.inner; ++q) {
+        Vec<D> c;
+        for (int k = 0; k < D; ++k) c[k] = rng.uniform(0.25 * L, 0.75 * L);
+        Corners<D> el;
+        for (auto& p : el)
+            for (int k = 0; k < D; ++k) p[k] = c[k] + rng.uniform(-1.5, 1.5);
+        inner.push_back(el);
+    }
+    if (!inner.empty()) w.surfaces.push_back(meshWall<D>(inner, 1));
+    int side = 1;
+    while (std::pow(side, D) < m.n) ++side;
+    const double a = (L - 1) / side;
+    for (int i = 0; i < m.n; ++i) {
+        Vec<D> x;
+        int r = i;
+        for (int k = 0; k < D; ++k) {
+            x[k] = 0.5 + (r % side + 0.5) * a;
+            r /= side;
+        }
+        const double radius = rng.uniform(0.3, 0.5);
+        if (meshDistance(w, x) < radius + 0.05) continue;
+        Vec<D> v;
+        for (int k = 0; k < D; ++k) v[k] = 2 * rng.normal();
+        Ang<D> s;
+        for (int k = 0; k < kAngDim<D>; ++k) s[k] = rng.normal();
+        w.particles.add(x, v, s, radius, rng.uniform(0.5, 2.0), 0, static_cast<std::uint64_t>(i));
+    }
+    return w;
+}
+
+struct Logged {
+    double time;
+    std::uint32_t a, b;
+    bool wall;
+    bool operator==(const Logged& o) const { return time == o.time && a == o.a && b == o.b && wall == o.wall; }
+};
+
+template <int D>
+std::vector<Logged> runLogged(World<D> w, const EdmSettings& s, double tEnd, EdmStats* stats = nullptr) {
+    std::vector<Logged> log;
+    EdmEngine<D> eng(w, s);
+    const auto planes = static_cast<std::uint32_t>(w.walls.size());
+    eng.setObserver([&](const EdmCollision<D>& c) {
+        if (c.surface)
+            log.push_back({c.time, c.i, planes + 1000000 * c.partner + c.element, true});
+        else if (c.wall)
+            log.push_back({c.time, c.i, c.partner, true});
+        else
+            log.push_back({c.time, std::min(c.i, c.partner), std::max(c.i, c.partner), false});
+    });
+    eng.advanceTo(tEnd);
+    if (stats) *stats = eng.stats();
+    return log;
+}
+
+/// The fast engine (cell crossings, then neighbour shells of two thicknesses) and the reference twin process the
+/// same collisions in the same order at the same times, bit for bit, up to the time of the fast engine's
+/// minCollisions-th collision. Returns the fast run's statistics (cell crossings).
+template <int D>
+EdmStats compareWithReference(const World<D>& w, EdmSettings s, std::size_t minCollisions, bool shells = true) {
+    s.reference = false;
+    double tEnd = 0;
+    {
+        World<D> probe = w;
+        EdmEngine<D> eng(probe, s);
+        std::size_t count = 0;
+        struct Stop {};
+        eng.setObserver([&](const EdmCollision<D>& c) {
+            if (++count == minCollisions) {
+                tEnd = c.time;
+                throw Stop{};
+            }
+        });
+        try {
+            eng.advanceTo(1e6);
+        } catch (const Stop&) {
+        }
+        tEnd = std::nextafter(tEnd, kNever);
+    }
+    s.reference = true;
+    const std::vector<Logged> ref = runLogged(w, s, tEnd);
+    EXPECT_GE(ref.size(), minCollisions);
+    s.reference = false;
+    EdmStats cells;
+    for (const double shell : {0.0, 0.2, 0.7}) {
+        if (shell > 0 && !shells) continue;
+        SCOPED_TRACE(shell == 0 ? std::string("cell crossings") : "neighbour shells " + std::to_string(shell));
+        s.shell = shell;
+        EdmStats st;
+        const std::vector<Logged> fast = runLogged(w, s, tEnd, &st);
+        if (shell == 0) cells = st;
+        for (std::size_t k = 0; k < std::min(ref.size(), fast.size()); ++k)
+            if (!(fast[k] == ref[k])) {
+                ADD_FAILURE() << "collision " << k << " differs: fast (" << fast[k].a << ", " << fast[k].b << ", wall "
+                              << fast[k].wall << ", t " << fast[k].time << "), reference (" << ref[k].a << ", "
+                              << ref[k].b << ", wall " << ref[k].wall << ", t " << ref[k].time << ")";
+                break;
+            }
+        EXPECT_EQ(fast.size(), ref.size());
+    }
+    return cells;
+}
+
+/// How many of the logged collisions are with mesh elements.
+template <int D>
+std::size_t meshCollisions(const World<D>& w, EdmSettings s, double tEnd) {
+    std::size_t n = 0;
+    const std::vector<Logged> log = runLogged(w, s, tEnd);
+    for (const Logged& c : log) n += c.wall && c.b >= w.walls.size();
+    std::printf("%zu collisions, %zu with mesh elements, by t = %g s\n", log.size(), n, tEnd);
+    return n;
+}
+
+TEST(EdmMesh, MatchesReference2DBoxOfSegments) {
+    MeshGas m;
+    m.n = 30;
+    m.e = 0.95;
+    m.seed = 3;
+    const World<2> w = meshGas<2>(m);
+    ASSERT_GT(w.particles.size(), 20u);
+    EdmSettings s;
+    s.tcTime = 1e-3;
+    const EdmStats st = compareWithReference<2>(w, s, 8000);
+    EXPECT_GT(st.cellCrossings, 300u);
+    EXPECT_GT(meshCollisions<2>(w, s, 20.0), 300u);
+}
+
+TEST(EdmMesh, MatchesReference3DBoxOfTriangles) {
+    MeshGas m;
+    m.n = 27;
+    m.inner = 5;
+    m.seed = 4;
+    const World<3> w = meshGas<3>(m);
+    ASSERT_GT(w.particles.size(), 18u);
+    EdmSettings s;
+    s.tcTime = 1e-3;
+    compareWithReference<3>(w, s, 5000);
+    EXPECT_GT(meshCollisions<3>(w, s, 20.0), 500u);
+}
+
+TEST(EdmMesh, MatchesReferenceElasticRough3D) {
+    MeshGas m;
+    m.n = 27;
+    m.inner = 6;
+    m.e = 1;
+    m.mu = 0;
+    m.beta0 = 1;
+    m.seed = 5;
+    EdmSettings s;
+    s.tcModel = false;
+    s.tangential = EdmSettings::Tangential::Constant;
+    compareWithReference<3>(meshGas<3>(m), s, 3000);
+}
+
+// A mesh floor across periodic axes: the box frame of a particle moves where it crosses a periodic face (wraps), in
+// the fast engine at its cell crossings, in the reference at the face.
+TEST(EdmMesh, MatchesReferencePeriodicMeshFloor2D) {
+    MeshGas m;
+    m.n = 30;
+    m.inner = 3;
+    m.periodic = true;
+    m.seed = 6;
+    EdmSettings s;
+    s.tcTime = 1e-3;
+    compareWithReference<2>(meshGas<2>(m), s, 5000, false);
+}
+
+TEST(EdmMesh, MatchesReferencePeriodicMeshFloor3D) {
+    MeshGas m;
+    m.n = 27;
+    m.inner = 2;
+    m.periodic = true;
+    m.seed = 7;
+    EdmSettings s;
+    s.tcTime = 1e-3;
+    compareWithReference<3>(meshGas<3>(m), s, 2500, false);
+}
+
+// ---- a flat mesh is its plane ----------------------------------------------------------------------------------
+
+/// A ball in the box [0, L] (plane side walls and ceiling) bouncing elastically on a floor that is the plane y = 0
+/// (2D) or z = 0 (3D), or a flat mesh in it (3D: the example incline's 1600 jittered triangles; 2D: 120 collinear
+/// segments of unequal lengths): the times of its collisions and where it ends.
+template <int D>
+std::vector<double> bounces(bool mesh, bool rough, const Vec<D>& x0, const Vec<D>& v0, double tEnd, Vec<D>* end) {
+    World<D> w;
+    w.contact = rough ? edmContact(1.0, 0.4, 0.3) : edmContact(1.0);
+    w.domain.lo = Vec<D>::zero();
+    if constexpr (D == 3)
+        w.domain.hi = Vec<3>{{0.1, 0.05, 0.03}};
+    else
+        w.domain.hi = Vec<2>{{0.1, 0.03}};
+    w.domain.gravity = Vec<D>::zero();
+    w.domain.gravity[D - 1] = -9.81;
+    for (int k = 0; k < D; ++k) {
+        Vec<D> n = Vec<D>::zero();
+        n[k] = 1;
+        if (k < D - 1 || !mesh) w.walls.push_back(Wall<D>::plane(w.domain.lo, n, Vec<D>::zero(), 0));
+        w.walls.push_back(Wall<D>::plane(w.domain.hi, n * -1.0, Vec<D>::zero(), 0));
+    }
+    if (mesh) {
+        std::vector<Corners<D>> floor;
+        if constexpr (D == 3) {
+            for (const auto& t : readStl(std::string(HAET_SOURCE_DIR) + "/examples/meshes/incline.stl").triangles)
+                floor.push_back(t);
+        } else {
+            Rng rng(17, 3);
+            double x = -0.005;
+            while (x < 0.105) {
+                const double next = x + rng.uniform(0.0005, 0.0012);
+                floor.push_back({Vec<2>{{x, 0}}, Vec<2>{{next, 0}}});
+                x = next;
+            }
+        }
+        w.surfaces.push_back(meshWall<D>(floor, static_cast<int>(w.walls.size())));
+    }
+    w.particles.add(x0, v0, Ang<D>::zero(), 0.002, 2500, 0, 0);
+    EdmSettings s;
+    s.tcModel = false;
+    EdmEngine<D> eng(w, s);
+    std::vector<double> times;
+    eng.setObserver([&](const EdmCollision<D>& c) { times.push_back(c.time); });
+    eng.advanceTo(tEnd);
+    *end = w.particles.x[0];
+    return times;
+}
+
+template <int D>
+void flatMeshIsThePlane(bool rough, const Vec<D>& x0, const Vec<D>& v0, double tEnd, std::size_t least) {
+    Vec<D> endPlane, endMesh;
+    const std::vector<double> plane = bounces<D>(false, rough, x0, v0, tEnd, &endPlane);
+    const std::vector<double> mesh = bounces<D>(true, rough, x0, v0, tEnd, &endMesh);
+    ASSERT_EQ(mesh.size(), plane.size()) << "a collision more or less where elements meet";
+    EXPECT_GE(plane.size(), least);
+    double worst = 0;
+    for (std::size_t k = 0; k < plane.size(); ++k) worst = std::max(worst, std::abs(mesh[k] - plane[k]) / plane[k]);
+    EXPECT_LT(worst, 1e-12);
+    EXPECT_LT(norm(endMesh - endPlane), 1e-12);
+    ::testing::Test::RecordProperty("max_relative_time_difference", std::to_string(worst));
+}
+
+TEST(EdmMesh, FlatTriangleFloorIsThePlane) {
+    // Hopping across the incline's 1600 triangles, smooth and rough.
+    flatMeshIsThePlane<3>(false, Vec<3>{{0.013, 0.021, 0.012}}, Vec<3>{{0.31, 0.17, 0.05}}, 2.0, 25);
+    flatMeshIsThePlane<3>(true, Vec<3>{{0.013, 0.021, 0.012}}, Vec<3>{{0.31, 0.17, 0.05}}, 2.0, 25);
+}
+
+TEST(EdmMesh, FlatSegmentFloorIsThePlane) {
+    flatMeshIsThePlane<2>(false, Vec<2>{{0.013, 0.012}}, Vec<2>{{0.37, 0.05}}, 2.0, 25);
+    flatMeshIsThePlane<2>(true, Vec<2>{{0.013, 0.012}}, Vec<2>{{0.37, 0.05}}, 2.0, 25);
+}
+
+// Dropped onto a vertex shared by six triangles, or onto an edge between two, or onto a segment end shared by two
+// segments: one collision per landing, as on the plane, not one per element (the second element finds the ball
+// receding from the same feature: no event, docs/physics.md D.6), and it bounces straight up.
+TEST(EdmMesh, SharedEdgesAndVerticesCollideOnce) {
+    const auto tris = readStl(std::string(HAET_SOURCE_DIR) + "/examples/meshes/incline.stl").triangles;
+    const auto& p = tris[2 * (20 * 17 + 9)];  // a cell away from the rim
+    const double a = 0.002;
+    for (const Vec<3>& q : {p[0], p[1], p[2], (p[0] + p[1]) * 0.5, (p[1] + p[2]) * 0.5}) {
+        SCOPED_TRACE(::testing::Message() << "at " << q[0] << ", " << q[1]);
+        const Vec<3> x0 = q + Vec<3>{{0, 0, a + 0.004}};
+        flatMeshIsThePlane<3>(false, x0, Vec<3>{}, 1.0, 15);
+        Vec<3> end;
+        bounces<3>(true, false, x0, Vec<3>{}, 1.0, &end);
+        EXPECT_LT(std::abs(end[0] - x0[0]) + std::abs(end[1] - x0[1]), 1e-12);
+    }
+    // 2D: onto the join of two segments of the floor (the ends as bounces<2> draws them).
+    Rng rng(17, 3);
+    double join = -0.005;
+    while (join < 0.05) join += rng.uniform(0.0005, 0.0012);
+    flatMeshIsThePlane<2>(false, Vec<2>{{join, a + 0.004}}, Vec<2>{}, 1.0, 15);
+}
+
+// ---- energy books of a pure event-driven run ------------------------------------------------------------------
+
+template <int D>
+double totalEnergy(const World<D>& w) {
+    double e = 0;
+    const Particles<D>& p = w.particles;
+    for (std::size_t i = 0; i < p.size(); ++i)
+        e += 0.5 * p.mass[i] * norm2(p.v[i]) + 0.5 * p.inertia(i) * norm2(p.w[i]) -
+             p.mass[i] * dot(w.domain.gravity, p.x[i]);
+    return e;
+}
+
+/// A gas in a box of mesh walls with random elements inside, under gravity: kinetic + rotational + potential energy
+/// minus what the collisions dissipated stays the initial energy, to round-off (elastic: the energy itself), and no
+/// particle leaves the box or passes into an element.
+template <int D>
+void energyBooks(double e) {
+    MeshGas m;
+    m.n = D == 3 ? 64 : 49;
+    m.e = e;
+    m.mu = e == 1 ? 0.0 : 0.3;
+    m.beta0 = e == 1 ? -1.0 : 0.4;
+    m.seed = 11;
+    World<D> w = meshGas<D>(m);
+    const std::size_t n = w.particles.size();
+    EdmSettings s;
+    s.tcModel = e < 1;
+    s.tcTime = 1e-3;
+    EdmEngine<D> eng(w, s);
+    const double e0 = totalEnergy(w);
+    double scale = 0;
+    for (std::size_t i = 0; i < n; ++i) scale += w.particles.mass[i] * norm(w.domain.gravity) * m.L;
+    for (int k = 1; k <= 10; ++k) {
+        eng.advanceTo(k * (e < 1 ? 1.0 : 5.0));  // a dissipative gas settles into a hopping bed: more events
+        const double books = e0 - totalEnergy(w) - eng.stats().dissipated;
+        EXPECT_LT(std::abs(books), 1e-12 * scale) << "t = " << w.time;
+        if (e == 1) {
+            EXPECT_LT(std::abs(eng.stats().dissipated), 1e-12 * scale);
+        }
+    }
+    ASSERT_EQ(w.particles.size(), n);
+    double worst = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double r = w.particles.radius[i];
+        worst = std::max(worst, (r - meshDistance(w, w.particles.x[i])) / r);
+        for (int k = 0; k < D; ++k) EXPECT_TRUE(w.particles.x[i][k] > 0 && w.particles.x[i][k] < m.L) << i;
+    }
+    EXPECT_LT(worst, 1e-9) << "a particle overlaps a mesh element";
+    EXPECT_GT(eng.stats().wallCollisions, D == 3 ? 2000u : 300u);
+    EXPECT_GT(eng.stats().pairCollisions, 500u);
+}
+
+TEST(EdmMesh, ElasticRunConservesEnergy2D) { energyBooks<2>(1.0); }
+TEST(EdmMesh, ElasticRunConservesEnergy3D) { energyBooks<3>(1.0); }
+TEST(EdmMesh, DissipativeRunBalancesItsBooks3D) { energyBooks<3>(0.7); }
+
+// ---- what the engine refuses ----------------------------------------------------------------------------------
+
+TEST(EdmMesh, WallsItCannotPredictAreRefusedUnlessGuarded) {
+    World<2> w = meshGas<2>(MeshGas{});
+    auto refused = [&](const World<2>& world, const std::string& what) {
+        World<2> copy = world;
+        try {
+            EdmEngine<2> eng(copy, EdmSettings{});
+            ADD_FAILURE() << "no error: " << what;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+        }
+        EdmSettings guarded;
+        guarded.guardedWalls = true;
+        copy = world;
+        const EdmEngine<2> eng(copy, guarded);
+        EXPECT_EQ(eng.meshWalls().size(), w.surfaces[0].elementCount() + w.surfaces[1].elementCount());
+    };
+    World<2> arc = w;
+    SurfaceWall<2> drum;
+    drum.kind = SurfaceKind::Arc;
+    drum.centre = Vec<2>::filled(5);
+    drum.radius = 5;
+    drum.angle1 = 2 * testing::kPiEdm;
+    drum.id = 2;
+    arc.surfaces.push_back(drum);
+    refused(arc, "wall 3 is curved");
+    World<2> turning = w;
+    SurfaceWall<2> blade = meshWall<2>({{Vec<2>{{4, 4}}, Vec<2>{{6, 4}}}}, 2);
+    blade.motion.omega = 1;
+    blade.motion.centre = Vec<2>::filled(5);
+    turning.surfaces.push_back(blade);
+    refused(turning, "wall 3 moves");
+    World<2> shaken = w;
+    Wall<2> floor = Wall<2>::plane(Vec<2>{}, Vec<2>{{0, 1}}, Vec<2>{}, 0);
+    floor.amplitude = Vec<2>{{0, 0.01}};
+    floor.frequency = 20;
+    shaken.walls.push_back(floor);
+    refused(shaken, "oscillates");
+}
+
+}  // namespace
+}  // namespace haet
