@@ -12,7 +12,9 @@
 
 #include "core/rng.hpp"
 #include "io/stl.hpp"
+#include "scenario/loader.hpp"
 #include "test_edm_util.hpp"
+#include "world/build.hpp"
 
 namespace haet {
 namespace {
@@ -489,6 +491,112 @@ TEST(EdmMesh, WallsItCannotPredictAreRefusedUnlessGuarded) {
     floor.frequency = 20;
     shaken.walls.push_back(floor);
     refused(shaken, "oscillates");
+}
+
+// ---- the scenario's walls and the methods ---------------------------------------------------------------------
+
+std::string wallScene(int dim, const std::string& method, const std::string& walls) {
+    const std::string lo = dim == 2 ? "[0, 0]" : "[0, 0, 0]", hi = dim == 2 ? "[1, 1]" : "[1, 1, 1]";
+    return "name = \"w\"\ndimension = " + std::to_string(dim) + "\nmethod = \"" + method +
+           "\"\nduration = 0.1\n[domain]\nlo = " + lo + "\nhi = " + hi +
+           "\n[materials.m]\ndensity = 1000\nrestitution = 0.5\nfriction = 0.3\n[contact]\nnormal = "
+           "\"linear\"\nduration = 1e-4\n" +
+           walls;
+}
+
+std::string wall(const std::string& keys) { return "[[walls]]\nmaterial = \"m\"\n" + keys; }
+
+const std::string kFloor2 = wall("point = [0, 0]\nnormal = [0, 1]\n");
+const std::string kSegment = wall("type = \"segment\"\npoints = [[0.1, 0.5], [0.9, 0.4]]\n");
+const std::string kCircle = wall("type = \"circle\"\ncenter = [0.5, 0.5]\nradius = 0.4\n");
+const std::string kMesh =
+    wall("type = \"mesh\"\nvertices = [[0, 0, 0.1], [1, 0, 0.1], [0, 1, 0.2]]\ntriangles = [[0, 1, 2]]\n");
+
+void expectRejected(const std::string& text, const std::string& key, const std::string& what) {
+    try {
+        parseScenario(text, "walls.toml");
+        ADD_FAILURE() << "no error for " << key;
+    } catch (const ScenarioError& e) {
+        const std::string msg = e.what();
+        EXPECT_EQ(e.key(), key) << msg;
+        EXPECT_NE(msg.find("walls.toml:"), std::string::npos) << msg;
+        EXPECT_NE(msg.find(what), std::string::npos) << msg;
+        EXPECT_NE(msg.find("method = \"haet\""), std::string::npos) << msg;
+        EXPECT_NE(msg.find("method = \"tdm\""), std::string::npos) << msg;
+    }
+}
+
+TEST(EdmMeshInput, EventDrivenRunsTakePlanesAndStaticMeshes) {
+    // Accepted: planes at a constant velocity, static segments, polylines, meshes, rectangles.
+    EXPECT_NO_THROW(parseScenario(
+        wallScene(2, "edm",
+                  wall("point = [0, 1]\nnormal = [0, -1]\nvelocity = [0, -0.1]\n") + kSegment +
+                      wall("type = \"polyline\"\npoints = [[0.1, 0.2], [0.5, 0.1], [0.9, 0.2]]\nclosed = true\n")),
+        "walls.toml"));
+    EXPECT_NO_THROW(parseScenario(
+        wallScene(3, "edm",
+                  kMesh + wall("type = \"rectangle\"\ncenter = [0.5, 0.5, 0.5]\nedges = [[0.2, 0, 0], [0, 0.2, 0]]\n")),
+        "walls.toml"));
+    // Rejected, naming the wall and the key, saying what to use instead.
+    expectRejected(wallScene(2, "edm", kFloor2 + kCircle), "walls[2].type", "\"circle\" wall is curved");
+    expectRejected(wallScene(2, "edm", wall("type = \"arc\"\ncenter = [0.5, 0.5]\nradius = 0.4\nangles = [0, 90]\n")),
+                   "walls[1].type", "\"arc\" wall is curved");
+    expectRejected(
+        wallScene(3, "edm",
+                  wall("type = \"cylinder\"\nbase = [0.5, 0.5, 0]\naxis = [0, 0, 1]\nlength = 1\nradius = 0.4\n")),
+        "walls[1].type", "\"cylinder\" wall is curved");
+    expectRejected(
+        wallScene(3, "edm", wall("type = \"disc\"\ncenter = [0.5, 0.5, 0.5]\nnormal = [0, 0, 1]\nradius = 0.3\n")),
+        "walls[1].type", "\"disc\" wall is curved");
+    expectRejected(
+        wallScene(2, "edm",
+                  wall("point = [0, 0]\nnormal = [0, 1]\noscillation = { amplitude = [0, 0.01], frequency = 20 }\n")),
+        "walls[1].oscillation", "oscillating plane");
+    expectRejected(wallScene(2, "edm",
+                             kFloor2 + wall("type = \"segment\"\npoints = [[0.1, 0.5], [0.9, 0.5]]\n"
+                                            "rotation = { center = [0.5, 0.5], omega = 2 }\n")),
+                   "walls[2].rotation", "moving wall");
+    expectRejected(wallScene(3, "edm",
+                             wall("type = \"mesh\"\nvertices = [[0, 0, 0.1], [1, 0, 0.1], [0, 1, 0.2]]\n"
+                                  "triangles = [[0, 1, 2]]\nvelocity = [0, 0, 0.1]\n")),
+                   "walls[1].velocity", "moving wall");
+    // The hybrid and the time-driven engine take them all.
+    for (const char* method : {"haet", "tdm"}) {
+        EXPECT_NO_THROW(parseScenario(wallScene(2, method, kFloor2 + kCircle), "walls.toml")) << method;
+        EXPECT_NO_THROW(parseScenario(
+            wallScene(
+                2, method,
+                wall("point = [0, 0]\nnormal = [0, 1]\noscillation = { amplitude = [0, 0.01], frequency = 20 }\n") +
+                    wall("type = \"segment\"\npoints = [[0.1, 0.5], [0.9, 0.5]]\n"
+                         "rotation = { center = [0.5, 0.5], omega = 2 }\n")),
+            "walls.toml"))
+            << method;
+    }
+}
+
+// The example silo of segments, shortened and thinned (its header lists the overrides), event-driven: particles
+// pour through the orifice onto the floor, none lost, none through a segment.
+TEST(EdmMeshInput, HopperOfSegmentsRunsEventDriven) {
+    const Scenario sc =
+        loadScenario(std::string(HAET_SOURCE_DIR) + "/examples/hopper2d.toml", {"method=edm", "insert[1].count=300"});
+    World<2> w = buildWorld<2>(sc);
+    const std::size_t n = w.particles.size();
+    ASSERT_EQ(n, 300u);
+    EdmSettings s = edmSettings(sc);
+    EdmEngine<2> eng(w, s);
+    EXPECT_GT(eng.meshWalls().size(), 3u);
+    eng.advanceTo(0.3);
+    ASSERT_EQ(w.particles.size(), n);
+    double worst = 0;
+    std::size_t below = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double r = w.particles.radius[i];
+        worst = std::max(worst, (r - meshDistance(w, w.particles.x[i])) / r);
+        below += w.particles.x[i][1] < 0.3;
+    }
+    EXPECT_LT(worst, 1e-9) << "a particle overlaps a segment";
+    EXPECT_GT(below, 10u) << "particles pour through the orifice";
+    EXPECT_GT(eng.stats().wallCollisions, 1000u);
 }
 
 }  // namespace

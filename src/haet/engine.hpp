@@ -14,6 +14,7 @@
 
 #include "edm/engine.hpp"
 #include "haet/edm_book.hpp"
+#include "haet/wall_guard.hpp"
 #include "haet/zones.hpp"
 #include "neighbor/cell_grid.hpp"
 #include "tdm/engine.hpp"
@@ -46,7 +47,8 @@ struct HaetCounters {
     std::uint64_t toTdm = 0, toEdm = 0;  ///< mode changes
     std::uint64_t tcHandovers = 0;       ///< particles handed to the TDM by the modified EDM (A.4)
     std::uint64_t nearTdm = 0;           ///< event-driven particles that came within reach of a TDM particle
-    std::uint64_t relabels = 0;          ///< zone relabellings
+    std::uint64_t nearWall = 0;  ///< event-driven particles that came within reach of a wall the EDM does not predict
+    std::uint64_t relabels = 0;  ///< zone relabellings
 };
 
 template <int D>
@@ -122,6 +124,11 @@ private:
     /// excluded); infinity if none.
     /// bound (if given): a lower bound of the gap to every binned TDM particle, also those beyond the margin.
     double gapToTdm(const Vec<D>& x, double r, double* bound = nullptr) const;
+    /// The walls the event-driven engine does not predict (WallGuard): their cells guarded at level 1 at least.
+    void guardWalls();
+    /// Whether a particle (centre x in event-grid cell `cell`, radius r, speed [m/s]) near such a wall is to be
+    /// time-driven: its gap to the wall could close before the next due step, or (due) it is within the margin.
+    bool nearGuardedWall(std::uint32_t cell, const Vec<D>& x, double r, double speed, bool due) const;
     double particleEnergy(std::size_t i) const;
     double tdmEnergy() const;
 
@@ -139,6 +146,7 @@ private:
     std::vector<std::uint32_t> binHead_, binCells_;
     std::vector<Binned> bins_;
     NearGrid near_;
+    WallGuard<D> walls_;  // the walls the event-driven engine leaves to the time-driven one
     double rmax_ = 0;
     std::vector<std::uint32_t> watch_;  // event-driven particles in guard cells (World indices)
     std::size_t watchSorted_ = 0;       // watch_[0, watchSorted_) is sorted and unique
