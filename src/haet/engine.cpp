@@ -306,9 +306,11 @@ void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals, bool due)
 // before the next refresh (a due relabel at the latest: relabelEvery + 1 steps), are guarded like the cells around a
 // TDM particle: their occupants are watched, and entering them is reported (docs/haet.md).
 template <int D>
-void HaetEngine<D>::guardWalls() {
+void HaetEngine<D>::guardWalls(bool due) {
     if (walls_.empty()) return;
-    walls_.refresh(book_.cells(), w_.time, ts_.dt * (hs_.relabelEvery + 1), rmax_, margin_);
+    // Binned on due steps, over the time to the step after the next one: a relabel between them (a pair-list
+    // build) keeps the cells.
+    if (due) walls_.refresh(book_.cells(), w_.time, ts_.dt * (hs_.relabelEvery + 1), rmax_, margin_);
     walls_.moveTo(w_.time);
     for (const std::uint32_t c : walls_.cells()) {
         std::uint8_t& g = guard_[c];
@@ -435,7 +437,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
         }
     }
     for (std::size_t b = 0, nb = binCells_.size(); b < nb; ++b) markAround(binCells_[b], 1);
-    guardWalls();
+    guardWalls(due);
     // A candidate within reach of a staying TDM particle, or whose event-grid cell belongs to a time-driven zone,
     // stays (it would be handed back at once); so may its neighbours then: a candidate that stays puts the
     // candidates of the cells around it back on the work list.

@@ -124,8 +124,9 @@ private:
     /// excluded); infinity if none.
     /// bound (if given): a lower bound of the gap to every binned TDM particle, also those beyond the margin.
     double gapToTdm(const Vec<D>& x, double r, double* bound = nullptr) const;
-    /// The walls the event-driven engine does not predict (WallGuard): their cells guarded at level 1 at least.
-    void guardWalls();
+    /// The walls the event-driven engine does not predict (WallGuard): their cells guarded at level 1 at least,
+    /// binned anew on due steps.
+    void guardWalls(bool due);
     /// Whether a particle (centre x in event-grid cell `cell`, radius r, speed [m/s]) near such a wall is to be
     /// time-driven: its gap to the wall could close before the next due step, or (due) it is within the margin.
     bool nearGuardedWall(std::uint32_t cell, const Vec<D>& x, double r, double speed, bool due) const;

@@ -8,8 +8,8 @@
 // before the next refresh, and a ring of one cell around them, are "near": the hybrid guards them (their occupants
 // are watched). Each near cell lists the walls' elements within that reach plus the ring of it, so the gap of a
 // watched particle to the walls is a minimum over its cell's list, and every element not listed is farther than the
-// list's reach. Static walls are binned once; moving ones at every refresh (every relabel of the hybrid), over the
-// distance their points can move until the next.
+// list's reach. Static walls are binned once; moving ones at every refresh (every due relabel of the hybrid), over
+// the distance their points can move until the next.
 #include <cstdint>
 #include <vector>
 
@@ -29,7 +29,7 @@ public:
     double speed() const { return speed_; }
 
     /// Bins the guarded walls at time t into the cells for particles of radius <= rmax [m] that must stay `margin`
-    /// [m] away from them until t + ahead [s]. Static walls are binned at the first call only.
+    /// [m] away from them until t + ahead [s]. Static walls are binned at the first call only (per grid).
     void refresh(const CellGrid<D>& cells, double t, double ahead, double rmax, double margin);
     bool near(std::uint32_t cell) const { return !near_.empty() && near_[cell]; }
     /// The near cells (after refresh).
