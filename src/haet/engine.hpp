@@ -38,8 +38,9 @@ struct HaetEnergy {
     double dissipatedTdm = 0;  ///< lost in time-driven contacts (the TDM particles' energy balance)
     double dissipatedEdm = 0;  ///< lost in event-driven collisions (summed at each collision)
     double total = 0;          ///< total energy now
-    /// initial - total - dissipatedTdm - dissipatedEdm: what neither engine accounts for (moving walls'
-    /// work, round-off). Zero for static walls, to the accuracy of the time integration.
+    /// initial - total - dissipatedTdm - dissipatedEdm: what neither engine accounts for (round-off). A moving
+    /// wall's work is in the dissipation of the engine whose particles it touches (dissipatedTdm is a balance,
+    /// dissipatedEdm sums each collision's loss, a moving plane's work included; docs/haet.md).
     double unaccounted = 0;
 };
 
