@@ -56,13 +56,15 @@ bool EdmEngine<D>::smoothPair(int matA, int matB) const {
 
 template <int D>
 void EdmEngine<D>::notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop,
-                          const Vec<D>& P) {
+                          const Vec<D>& P, std::uint32_t element) {
     if (!collisionHook_) return;
     EdmCollision<D> c;
     c.time = t;
     c.i = sl_.rec[a].idx;
     c.partner = wall ? partner : sl_.rec[partner].idx;
     c.wall = wall;
+    c.surface = element != kNil;
+    c.element = c.surface ? element : 0;
     c.elastic = elastic;
     c.restHop = hop;
     c.impulse = P;
@@ -171,13 +173,61 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     notify(t, s, w, true, elastic, hop, P);
 }
 
+// A mesh element as a plane wall at rest whose normal is the contact's (predict_mesh.hpp: from the contact point to the
+// centre, the gradient of the distance; a face's own normal on its inside), so a flat mesh bounces a particle as its
+// plane does (docs/physics.md D.8). The contact is the element's canonical one at t (MeshWalls::contact), the same
+// computation that scheduled the event.
+template <int D>
+void EdmEngine<D>::collideMesh(std::uint32_t s, std::uint32_t e, double t) {
+    Particles<D>& p = w_.particles;
+    const std::uint32_t i = sl_.rec[s].idx;
+    const MeshContact<D> hit = mesh_.contact(sl_, s, e, t);
+    const Vec<D> n = hit.normal;
+    const int wallMaterial = mesh_.material(e);
+    const double uRest = tc_.restSpeed(dot(n, sl_.g));
+    const Vec<D> vs = sl_.velAt(sl_.hot[s], t);
+    const int ma = materialOf(i);
+    const bool smooth = smoothPair(ma, wallMaterial);  // as in collidePair
+    CollisionBody<D> b1{vs, smooth ? Ang<D>::zero() : p.w[i], sl_.hot[s].r, p.invMass[i],
+                        smooth ? 0.0 : p.invInertia[i]};
+    CollisionBody<D> b2{Vec<D>::zero(), Ang<D>::zero(), 0.0, 0.0, 0.0};
+    const double gn = dot(vs, n);
+    if (hit.feature == MeshFeature::None || (gn >= 0 && !(uRest > gn))) {
+        // Not approaching (a graze to rounding): no impulse. Unlike a plane's, the state is committed at t, so that
+        // the next prediction starts at the contact (touching, not approaching: no event now, D.6) instead of
+        // finding this one again; the counter makes the partners' events that knew the older state stale.
+        sl_.advance(s, t);
+        ++sl_.link[s].count;
+        ++stats_.grazing;
+        return;
+    }
+    sl_.advance(s, t);
+    const bool elastic = tc_.elastic(s, kNil, t);
+    bool hop = false;
+    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(ma, wallMaterial, elastic), gn < 0, gn, uRest, hop);
+    const double before = kineticEnergy(b1);
+    applyImpulse(b1, b2, n, P);
+    stats_.dissipated += before - kineticEnergy(b1);
+    if (elastic && observer_) observer_->tcCollision(i);
+    sl_.hot[s].v = b1.v;
+    if (!smooth) p.w[i] = b1.w;
+    ++sl_.link[s].count;
+    tc_.collided(s, t);
+    ++stats_.wallCollisions;
+    if (elastic) ++stats_.tcElastic;
+    if (hop) ++stats_.restHops;
+    notify(t, s, mesh_.wall(e), true, elastic, hop, P, mesh_.local(e));
+}
+
 // The members defined here, for both dimensions (the class itself is instantiated in edm/engine.cpp).
-#define HAET_EDM_COLLIDE(D)                                                                                    \
-    template CollisionLaw EdmEngine<D>::lawFor(int, int, bool) const;                                          \
-    template bool EdmEngine<D>::smoothPair(int, int) const;                                                    \
-    template void EdmEngine<D>::notify(double, std::uint32_t, std::uint32_t, bool, bool, bool, const Vec<D>&); \
-    template void EdmEngine<D>::collidePair(std::uint32_t, std::uint32_t, double);                             \
-    template void EdmEngine<D>::collideWall(std::uint32_t, std::uint32_t, double);
+#define HAET_EDM_COLLIDE(D)                                                                                   \
+    template CollisionLaw EdmEngine<D>::lawFor(int, int, bool) const;                                         \
+    template bool EdmEngine<D>::smoothPair(int, int) const;                                                   \
+    template void EdmEngine<D>::notify(double, std::uint32_t, std::uint32_t, bool, bool, bool, const Vec<D>&, \
+                                       std::uint32_t);                                                        \
+    template void EdmEngine<D>::collidePair(std::uint32_t, std::uint32_t, double);                            \
+    template void EdmEngine<D>::collideWall(std::uint32_t, std::uint32_t, double);                            \
+    template void EdmEngine<D>::collideMesh(std::uint32_t, std::uint32_t, double);
 HAET_EDM_COLLIDE(2)
 HAET_EDM_COLLIDE(3)
 #undef HAET_EDM_COLLIDE

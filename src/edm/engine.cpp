@@ -46,7 +46,18 @@ EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings, EdmObserve
             if (w_.domain.periodic[a] && std::abs(wl.normal[a]) > 1e-12)
                 throw std::invalid_argument("event-driven engine: wall " + std::to_string(k) +
                                             " is not parallel to periodic axis " + std::to_string(a));
+        // D.3 predicts a plane at constant velocity; an oscillating one is the coupled engine's (guardedWalls).
+        if (wl.oscillates()) {
+            if (!s_.guardedWalls)
+                throw std::invalid_argument("event-driven engine: wall " + std::to_string(k) +
+                                            " oscillates: only planes at a constant velocity are predicted");
+            continue;
+        }
+        planes_.push_back(static_cast<std::uint32_t>(k));
     }
+    mesh_.collect(w_, s_.guardedWalls);
+    if (w_.walls.size() + mesh_.size() >= (std::size_t{1} << kTypeShift))
+        throw std::invalid_argument("event-driven engine: too many walls");
     reset();
     if (observer) {
         if (shells_.on())
@@ -113,6 +124,9 @@ void EdmEngine<D>::reset() {
 
     // Slots in World order first, then sorted cell by cell.
     buildGrid();
+    // A particle's centre stays in its cell until it crosses (with shells: within the shell's half-edge of its
+    // centre's cell), so its cell's elements are all it can touch until its next such event.
+    mesh_.bin(grid_.cells(), rmax_, shells_.half());
     sl_.hot.resize(n);
     sl_.link.assign(n, Link{kNil, 0, Sl::packWraps(Shift{})});
     sl_.rec.assign(n, Rec{Kept{}, 0, 0, 0, 0});
@@ -291,16 +305,29 @@ template <class Broad>
     if (axis >= 0) {
         best = {keptTime(s, now), sl_.rec[s].coll.code, sl_.rec[s].coll.stamp};
     } else {
-        for (std::size_t w = 0; w < w_.walls.size(); ++w) {
+        for (const std::uint32_t w : planes_) {
             const double t = sl_.wallTime(s, w, now);
-            const std::uint32_t code = (kWall << kTypeShift) | static_cast<std::uint32_t>(w);
+            const std::uint32_t code = (kWall << kTypeShift) | w;
             if (best.better(t, code)) best = {t, code, 0};
         }
     }
+    // The elements of s's cell: after a crossing its new cell's, which the kept event does not know.
+    if (!mesh_.empty()) predictMesh(s, now, best);
     edm::Scanner<D> scan(sl_, hs, s, now, best);
     broad.forEachBatch(sl_, at, s, ws, axis, dir, scan);
     if (scan.bestJ != kNil) scan.best.stamp = sl_.link[scan.bestJ].count;
     setPending(s, scan.best, cross);
+}
+
+template <int D>
+void EdmEngine<D>::predictMesh(std::uint32_t s, double now, Candidate& best) const {
+    const std::uint32_t cell = sl_.rec[s].cell;
+    const std::uint32_t base = static_cast<std::uint32_t>(w_.walls.size());
+    for (const std::uint32_t* q = mesh_.cellBegin(cell); q != mesh_.cellEnd(cell); ++q) {
+        const double t = mesh_.time(sl_, s, *q, now, best.time);
+        const std::uint32_t code = (kWall << kTypeShift) | (base + *q);
+        if (best.better(t, code)) best = {t, code, 0};
+    }
 }
 
 template <int D>
@@ -337,6 +364,8 @@ double EdmEngine<D>::keptTime(std::uint32_t s, double now) const {
     const std::uint32_t k = c.code & kIndexMask;
     switch (c.code >> kTypeShift) {
         case kWall:
+            if (k >= w_.walls.size())
+                return mesh_.time(sl_, s, k - static_cast<std::uint32_t>(w_.walls.size()), now, kNever);
             return sl_.wallTime(s, k, now);
         case kPair: {
             const Vec<D> d = sl_.posAt(sl_.hot[s], now) - sl_.posAt(sl_.hot[k], now);
@@ -391,7 +420,10 @@ void EdmEngine<D>::processNext() {
             if (!frozen(k)) predict(k, t);
             return;
         case kWall:
-            collideWall(s, k, t);
+            if (k < w_.walls.size())
+                collideWall(s, k, t);
+            else
+                collideMesh(s, k - static_cast<std::uint32_t>(w_.walls.size()), t);
             predict(s, t);
             return;
         case kCell: {
@@ -499,19 +531,27 @@ void EdmEngine<D>::putBackState() {
 // The reference twin (edm/reference.hpp) names each next event; the collisions are the engine's.
 template <int D>
 void EdmEngine<D>::advanceReference(double t) {
-    const edm::Reference<D> ref(sl_, rmax_);
+    const edm::Reference<D> ref(sl_, rmax_, planes_, mesh_);
     double now = w_.time;
     for (;;) {
         const typename edm::Reference<D>::Event e = ref.next(now);
         if (e.time >= t) break;
         now = e.time;
-        if ((e.code >> kTypeShift) == kNone) continue;  // the horizon: look again from there
+        const std::uint32_t type = e.code >> kTypeShift, k = e.code & kIndexMask;
+        if (type == kNone) continue;  // the horizon: look again from there
+        if (type == kCell) {          // a periodic face: the box frame wraps, as at the fast engine's crossing
+            Shift ws = Sl::wrapsOf(sl_.link[e.slot].wrap);
+            ws[k >> 1] += (k & 1) ? 1 : -1;
+            sl_.setWraps(e.slot, ws);
+            continue;
+        }
         countEvent(e.time);
-        const std::uint32_t k = e.code & kIndexMask;
-        if ((e.code >> kTypeShift) == kPair)
+        if (type == kPair)
             collidePair(e.slot, k, e.time);
-        else
+        else if (k < w_.walls.size())
             collideWall(e.slot, k, e.time);
+        else
+            collideMesh(e.slot, k - static_cast<std::uint32_t>(w_.walls.size()), e.time);
     }
 }
 
@@ -672,7 +712,8 @@ template <int D>
 std::size_t EdmEngine<D>::memoryBytes() const {
     auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
     return bytes(sl_.hot) + bytes(sl_.link) + bytes(sl_.rec) + tc_.memoryBytes() + queue_.memoryBytes() +
-           grid_.memoryBytes() + bytes(slotOf_) + bytes(free_) + shells_.memoryBytes();
+           grid_.memoryBytes() + bytes(slotOf_) + bytes(free_) + shells_.memoryBytes() + bytes(planes_) +
+           mesh_.memoryBytes();
 }
 
 template class EdmEngine<2>;

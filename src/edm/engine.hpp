@@ -2,15 +2,17 @@
 // Event-driven engine for hard disks (D = 2) and spheres (D = 3): Lubachevsky's scheme (docs/physics.md D.1) with
 // one pending event per particle, collision counters for stale events, per-particle clocks (lazy updates),
 // neighbour shells (a list per particle of those it can reach while it stays near where the list was made) or a
-// cell grid with cell-crossing events, periodic images, moving plane walls, gravity, frozen particles, the
-// rough-particle collision operator with Walton's rule (C), and the TC model against inelastic collapse (D.7).
+// cell grid with cell-crossing events, periodic images, moving plane walls, static mesh walls (segments, triangles:
+// D.8), gravity, frozen particles, the rough-particle collision operator with Walton's rule (C), and the TC model
+// against inelastic collapse (D.7).
 // docs/edm.md describes the algorithm, the invalid-state rules and the defaults.
 //
 // The engine in parts: this class is the event loop (clocks, the event queue, dispatch of the events, particles
 // joining and leaving, synchronisation; the collisions in edm/collide.cpp); the particle state it shares with the
 // other parts is edm/slots.hpp; the broad phase is the event grid with its cell crossings (edm/event_grid.hpp) or the
 // neighbour shells (edm/shells.hpp), behind one interface; the batched candidate scan is edm/scan.hpp over the lane
-// primitives of core/lanes_scan.hpp; the TC model edm/tc_model.hpp; the reference twin edm/reference.hpp; a
+// primitives of core/lanes_scan.hpp; the mesh walls' elements, binned into the event grid's cells, and their
+// canonical times edm/mesh_walls.hpp; the TC model edm/tc_model.hpp; the reference twin edm/reference.hpp; a
 // coupled engine (the hybrid) follows the particles through edm/observer.hpp.
 #include <array>
 #include <cstdint>
@@ -21,6 +23,7 @@
 #include "edm/collision.hpp"
 #include "edm/event_grid.hpp"
 #include "edm/event_queue.hpp"
+#include "edm/mesh_walls.hpp"
 #include "edm/observer.hpp"
 #include "edm/predict.hpp"
 #include "edm/shells.hpp"
@@ -68,6 +71,10 @@ struct EdmSettings {
     /// Reference twin: the next event by brute force (all pairs and all walls at every event, O(N^2) per event),
     /// no cells, no queue. For tests.
     bool reference = false;
+    /// Walls this engine cannot predict (docs/physics.md H.6: walls of any shape that are curved or move,
+    /// oscillating planes) belong to a coupled engine, which keeps this engine's particles away from them (the
+    /// hybrid's guard, docs/haet.md): they are left out. false: such a wall is an error (std::invalid_argument).
+    bool guardedWalls = false;
 };
 
 /// One collision as seen by an observer (tests, diagnostics).
@@ -80,10 +87,15 @@ struct EdmCollision {
     bool elastic = false;  ///< made elastic by the TC model
     bool restHop = false;  ///< normal speed raised to the rest-hop speed (wall or frozen partner)
     Vec<D> impulse;        ///< impulse on particle i [N s]
+    /// The wall is a mesh: partner is its index in World::surfaces (else in World::walls), element which of its
+    /// elements.
+    bool surface = false;
+    std::uint32_t element = 0;
 };
 
 /// Counts of what the engine did.
 struct EdmStats {
+    /// Wall collisions: with planes and with the elements of meshes.
     std::uint64_t pairCollisions = 0, wallCollisions = 0;
     std::uint64_t cellCrossings = 0;  ///< cell-crossing events
     std::uint64_t shellExits = 0;     ///< neighbour-shell exits (list rebuilt)
@@ -167,6 +179,8 @@ public:
     double shellThickness() const { return 2 * shells_.half(); }
     double nextEventTime() const;     ///< time of the next pending event [s] (reference mode: infinity)
     std::size_t memoryBytes() const;  ///< heap memory of the engine's own arrays [bytes]
+    /// The mesh elements the engine predicts (its static meshes), binned into its cells.
+    const edm::MeshWalls<D>& meshWalls() const { return mesh_; }
 
 private:
     using Sl = edm::Slots<D>;
@@ -200,6 +214,10 @@ private:
     void advanceReference(double t);
     void collidePair(std::uint32_t a, std::uint32_t b, double t);
     void collideWall(std::uint32_t s, std::uint32_t w, double t);
+    /// Slot s against mesh element e (edm/mesh_walls.hpp) at time t, with the normal of the predicted contact.
+    void collideMesh(std::uint32_t s, std::uint32_t e, double t);
+    /// The best so far (best) against the mesh elements binned into slot s's cell, at time now.
+    [[gnu::noinline]] void predictMesh(std::uint32_t s, double now, Candidate& best) const;
     void syncSlot(std::uint32_t s, double t);
     void storeSlot(std::uint32_t s);
     void putBackState();
@@ -218,7 +236,8 @@ private:
     /// World particle i's material; with one material in the table not read (a World-order array: a cache miss
     /// per particle of a collision).
     int materialOf(std::uint32_t i) const { return w_.contact.nMaterials == 1 ? 0 : w_.particles.material[i]; }
-    void notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop, const Vec<D>& P);
+    void notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop, const Vec<D>& P,
+                std::uint32_t element = kNil);
 
     World<D>& w_;
     EdmSettings s_;
@@ -232,6 +251,10 @@ private:
     EventCalendar queue_;     // pending event times
     edm::EventGrid<D> grid_;  // cells and their lists (with neighbour shells: of the shells' centres)
     edm::Shells<D> shells_;   // neighbour shells (on: EdmSettings::shell > 0)
+    // The planes it predicts (World::walls indices: all but oscillating ones, which only a guarded run has) and the
+    // static meshes' elements; an element's event code is the wall code of World::walls.size() + its index.
+    std::vector<std::uint32_t> planes_;
+    edm::MeshWalls<D> mesh_;
 
     // particles joining and leaving: World index -> slot (kNil: not owned), free slots (rec[s].idx == kNil)
     std::vector<std::uint32_t> slotOf_;

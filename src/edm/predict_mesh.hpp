@@ -2,7 +2,7 @@
 // Event-time predictions against static mesh elements under gravity (docs/physics.md D.8): the first time a sphere
 // (disk) of radius a whose centre moves as c(t) = x + v t + g t^2/2 touches a segment (2D) or a triangle (3D), which
 // feature it touches (the face or segment interior, an edge, a vertex), where and along which normal. Pure functions,
-// no allocation; not yet called by the engine (the wall elements that will hold them come with the walls).
+// no allocation; the engine calls them for the elements of static meshes (edm/mesh_walls.hpp).
 //
 // The distance from c to an element is the least of the distances to its features, each counted only where the
 // feature's closest point lies in it (the Voronoi regions of Ericson 2005, 5.1.5): so the first contact is the

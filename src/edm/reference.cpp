@@ -9,7 +9,7 @@ template <int D>
 typename Reference<D>::Event Reference<D>::next(double now) const {
     using Shift = typename Slots<D>::Shift;
     const Domain<D>& dom = sl_.world->domain;
-    const std::size_t nWalls = sl_.world->walls.size();
+    const auto base = static_cast<std::uint32_t>(sl_.world->walls.size());
     const std::uint32_t n = static_cast<std::uint32_t>(sl_.size());
     // Within the horizon every particle moves less than delta, so a pair that collides is at its minimum image now
     // (|r| <= sigma + 2 delta <= L/2): the minimum image is enough.
@@ -28,9 +28,9 @@ typename Reference<D>::Event Reference<D>::next(double now) const {
     for (std::uint32_t s = 0; s < n; ++s) {
         if (sl_.frozen(s)) continue;
         Candidate c;
-        for (std::size_t w = 0; w < nWalls; ++w) {
+        for (const std::uint32_t w : planes_) {
             const double tw = sl_.wallTime(s, w, now);
-            const std::uint32_t code = (kWall << kTypeShift) | static_cast<std::uint32_t>(w);
+            const std::uint32_t code = (kWall << kTypeShift) | w;
             if (c.better(tw, code)) c = {tw, code, 0};
         }
         const Vec<D> xs = sl_.posAt(sl_.hot[s], now);
@@ -44,9 +44,30 @@ typename Reference<D>::Event Reference<D>::next(double now) const {
             const std::uint32_t code = (kPair << kTypeShift) | j;
             if (c.better(tp, code)) c = {tp, code, 0};
         }
+        // The mesh after the pairs, so that the best so far skips the elements out of reach (MeshWalls::time).
+        for (std::uint32_t e = 0; e < mesh_.size(); ++e) {
+            const double tm = mesh_.time(sl_, s, e, now, c.time);
+            const std::uint32_t code = (kWall << kTypeShift) | (base + e);
+            if (c.better(tm, code)) c = {tm, code, 0};
+        }
         if (c.time < best.time) best = {c.time, s, c.code};
     }
-    if (horizon < best.time) return {horizon, 0, kNone << kTypeShift};
+    if (horizon < best.time) best = {horizon, 0, kNone << kTypeShift};
+    if (!mesh_.empty() && lmin < kNever) {
+        // The box frame of a slot moves by a box length where its centre crosses a periodic face.
+        for (std::uint32_t s = 0; s < n; ++s) {
+            if (sl_.frozen(s)) continue;
+            const Shift ws = Slots<D>::wrapsOf(sl_.link[s].wrap);
+            const Vec<D> x = sl_.posAt(sl_.hot[s], now), v = sl_.velAt(sl_.hot[s], now);
+            for (int k = 0; k < D; ++k) {
+                if (!dom.periodic[k]) continue;
+                const CellExit ex =
+                    cellExitTime(x[k] - ws[k] * sl_.boxLen[k], v[k], sl_.g[k], dom.lo[k], dom.lo[k] + sl_.boxLen[k]);
+                if (now + ex.time < best.time)
+                    best = {now + ex.time, s, (kCell << kTypeShift) | static_cast<std::uint32_t>(2 * k + ex.up)};
+            }
+        }
+    }
     return best;
 }
 

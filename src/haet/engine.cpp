@@ -59,6 +59,9 @@ HaetEngine<D>::HaetEngine(World<D>& world, const TdmSettings& tdm, EdmSettings e
     edm.radiusBound = rmax;
     edm.tcTime = hs_.dtMin > 0 ? hs_.dtMin : w_.contact.contactTime;
     edm.tcModel = true;
+    // Curved and moving walls are the time-driven engine's: the guard keeps event-driven particles away from them.
+    walls_.collect(w_);
+    edm.guardedWalls = true;
     if (!(edm.cellSize > 0)) edm.cellSize = eventCellEdge(nT);
     edm.cellSize = std::max(edm.cellSize, 2 * rmax + ts_.skin);
     // The engine tells the book its grid and every particle's cell (EdmObserver): zone volumes, occupants, guard
@@ -258,10 +261,18 @@ void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals, bool due)
     const double horizon = ts_.dt * static_cast<double>(R - steps_ % R + 1);
     const double g = norm(w_.domain.gravity);
     std::size_t keep = 0;
+    if (!walls_.empty()) walls_.moveTo(w_.time);
     for (const std::uint32_t i : watch_) {
         if (!edm_->owns(i)) continue;
         const std::uint8_t level = guard_[book_.cellOf(i)] & 3;
         if (level == 0) continue;
+        if (walls_.near(book_.cellOf(i)) &&
+            nearGuardedWall(book_.cellOf(i), edm_->positionAt(i, w_.time), w_.particles.radius[i],
+                            norm(edm_->velocityAt(i, w_.time)), due)) {
+            arrivals.push_back(i);
+            ++counters_.nearWall;
+            continue;
+        }
         // Near a TDM particle only: skipped while it provably stays beyond the margin (below).
         const Quiet& q = quiet_[i];
         if (level == 1 && q.epoch == binsEpoch_ && w_.time < q.until && q.collisions == edm_->collisionCount(i)) {
@@ -290,6 +301,37 @@ void HaetEngine<D>::checkWatched(std::vector<std::uint32_t>& arrivals, bool due)
     }
     watch_.resize(keep);
     watchSorted_ = keep;
+}
+
+// The cells from which an event-driven particle could come near a wall the event-driven engine does not predict,
+// before the next refresh (a due relabel at the latest: relabelEvery + 1 steps), are guarded like the cells around a
+// TDM particle: their occupants are watched, and entering them is reported (docs/haet.md).
+template <int D>
+void HaetEngine<D>::guardWalls(bool due) {
+    if (walls_.empty()) return;
+    // Binned on due steps, over the time to the step after the next one: a relabel between them (a pair-list
+    // build) keeps the cells.
+    if (due) walls_.refresh(book_.cells(), w_.time, ts_.dt * (hs_.relabelEvery + 1), rmax_, margin_);
+    walls_.moveTo(w_.time);
+    for (const std::uint32_t c : walls_.cells()) {
+        std::uint8_t& g = guard_[c];
+        const std::uint8_t oldLevel = g & 3, newLevel = g >> 2;
+        if (newLevel >= 1) continue;
+        newList_.push_back(c);
+        g = static_cast<std::uint8_t>(oldLevel | (1 << 2));
+        if (oldLevel < 1) book_.forEachIn(c, [&](std::uint32_t i) { watch_.push_back(i); });
+    }
+}
+
+// Hand-overs wait for the due step, as near TDM particles, unless the gap could close before it: the particle flies
+// at most speed h + g h^2 / 2 and the wall's points move at most its speed h in the time h to the step after it.
+template <int D>
+bool HaetEngine<D>::nearGuardedWall(std::uint32_t cell, const Vec<D>& x, double r, double speed, bool due) const {
+    const double gap = walls_.gap(cell, x, r);
+    const std::uint64_t R = static_cast<std::uint64_t>(hs_.relabelEvery);
+    const double h = ts_.dt * static_cast<double>(R - steps_ % R + 1);
+    const double reach = (speed + walls_.speed()) * h + 0.5 * norm(w_.domain.gravity) * h * h;
+    return gap < reach || (due && gap < margin_);
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -396,6 +438,7 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
         }
     }
     for (std::size_t b = 0, nb = binCells_.size(); b < nb; ++b) markAround(binCells_[b], 1);
+    guardWalls(due);
     // A candidate within reach of a staying TDM particle, or whose event-grid cell belongs to a time-driven zone,
     // stays (it would be handed back at once); so may its neighbours then: a candidate that stays puts the
     // candidates of the cells around it back on the work list.
@@ -412,7 +455,9 @@ void HaetEngine<D>::relabel(std::vector<std::uint32_t> arrivals, bool due) {
         work.pop_back();
         if (stays[q]) continue;
         const auto [c, i] = byCell[q];
-        if ((guard_[c] >> 2) < 2 && gapToTdm(p.x[i], p.radius[i]) >= margin_) continue;
+        if ((guard_[c] >> 2) < 2 && gapToTdm(p.x[i], p.radius[i]) >= margin_ &&
+            !(walls_.near(c) && nearGuardedWall(c, p.x[i], p.radius[i], norm(p.v[i]), true)))
+            continue;
         stays[q] = 1;
         const bool fresh = binHead_[c] == kNil;
         bin(p.x[i], p.radius[i]);

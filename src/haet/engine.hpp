@@ -14,6 +14,7 @@
 
 #include "edm/engine.hpp"
 #include "haet/edm_book.hpp"
+#include "haet/wall_guard.hpp"
 #include "haet/zones.hpp"
 #include "neighbor/cell_grid.hpp"
 #include "tdm/engine.hpp"
@@ -41,7 +42,9 @@ struct HaetEnergy {
     double inflow = 0;         ///< brought by particles that were added (inlets), at their birth
     double outflow = 0;        ///< taken away by particles that were removed (outlets), their contacts' included
     /// initial + inflow - outflow - total - dissipatedTdm - dissipatedEdm: what neither engine accounts for
-    /// (moving walls' work, round-off). Zero for static walls, to the accuracy of the time integration.
+    /// (round-off). A moving wall's work is in the dissipation of the engine whose particles it touches
+    /// (dissipatedTdm is a balance, dissipatedEdm sums each collision's loss, a moving plane's work included;
+    /// docs/haet.md).
     double unaccounted = 0;
 };
 
@@ -49,7 +52,8 @@ struct HaetCounters {
     std::uint64_t toTdm = 0, toEdm = 0;  ///< mode changes
     std::uint64_t tcHandovers = 0;       ///< particles handed to the TDM by the modified EDM (A.4)
     std::uint64_t nearTdm = 0;           ///< event-driven particles that came within reach of a TDM particle
-    std::uint64_t relabels = 0;          ///< zone relabellings
+    std::uint64_t nearWall = 0;  ///< event-driven particles that came within reach of a wall the EDM does not predict
+    std::uint64_t relabels = 0;  ///< zone relabellings
 };
 
 template <int D>
@@ -133,6 +137,12 @@ private:
     /// excluded); infinity if none.
     /// bound (if given): a lower bound of the gap to every binned TDM particle, also those beyond the margin.
     double gapToTdm(const Vec<D>& x, double r, double* bound = nullptr) const;
+    /// The walls the event-driven engine does not predict (WallGuard): their cells guarded at level 1 at least,
+    /// binned anew on due steps.
+    void guardWalls(bool due);
+    /// Whether a particle (centre x in event-grid cell `cell`, radius r, speed [m/s]) near such a wall is to be
+    /// time-driven: its gap to the wall could close before the next due step, or (due) it is within the margin.
+    bool nearGuardedWall(std::uint32_t cell, const Vec<D>& x, double r, double speed, bool due) const;
     double particleEnergy(std::size_t i) const;
     double tdmEnergy() const;
 
@@ -150,6 +160,7 @@ private:
     std::vector<std::uint32_t> binHead_, binCells_;
     std::vector<Binned> bins_;
     NearGrid near_;
+    WallGuard<D> walls_;  // the walls the event-driven engine leaves to the time-driven one
     double rmax_ = 0;
     std::vector<std::uint32_t> watch_;  // event-driven particles in guard cells (World indices)
     std::size_t watchSorted_ = 0;       // watch_[0, watchSorted_) is sorted and unique

@@ -619,13 +619,15 @@ void describeEdm(const Scenario& sc, std::ostream& out) {
     out << fmt::format("method     edm (event-driven), {}D, tangential {}\n", D,
                        sc.edm.tangential == EdmTangential::Constant ? "constant beta" : "Walton's rule");
     out << fmt::format("particles  {}, {} materials, {} walls\n", world.particles.size(), sc.materials.size(),
-                       world.walls.size());
+                       world.walls.size() + world.surfaces.size());
+    describeWalls(world, out);
     out << fmt::format("collapse   TC model {} (tc_time = {:.4g} s)\n", sc.edm.tcModel ? "on" : "off", tc);
     for (std::size_t a = 0; a < sc.materials.size(); ++a)
         out << fmt::format("material   {}: restitution {:.5f} (the soft law's, incl. contact-end rule)\n",
                            sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
-    out << fmt::format("physics    docs/physics.md C.1-C.2 collision rule, D.2-D.4 event times, D.6 invalid states{}\n",
-                       sc.edm.tcModel ? ", D.7 TC model" : "");
+    out << fmt::format(
+        "physics    docs/physics.md C.1-C.2 collision rule, D.2-D.4 event times, D.6 invalid states{}{}\n",
+        sc.edm.tcModel ? ", D.7 TC model" : "", world.surfaces.empty() ? "" : ", D.8 mesh walls");
 }
 
 template <int D>
@@ -639,7 +641,8 @@ void describeHaet(const Scenario& sc, std::ostream& out) {
     out << fmt::format("method     haet (time-driven where dense, event-driven where dilute), {}D, integrator {}\n", D,
                        ts.integrator == IntegratorKind::Gear5 ? "gear5" : "verlet");
     out << fmt::format("particles  {}: {} time-driven, {} event-driven at the start; {} walls\n",
-                       world.particles.size(), eng.nTdm(), eng.nEdm(), world.walls.size());
+                       world.particles.size(), eng.nTdm(), eng.nEdm(), world.walls.size() + world.surfaces.size());
+    describeWalls(world, out);
     out << fmt::format("contact    t_c = {:.4g} s ({})\n", world.contact.contactTime, world.contact.contactTimeNote);
     out << fmt::format("time step  dt = {:.4g} s ({}); {:.0f} steps for {:.4g} s\n", ts.dt, dtNote,
                        std::ceil(sc.duration / ts.dt), sc.duration);
@@ -662,8 +665,9 @@ void describeHaet(const Scenario& sc, std::ostream& out) {
             sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
     out << fmt::format(
         "physics    docs/physics.md A.1 one physics, A.2 zones, A.4 modified EDM; {}; C.1-C.2 collision rule, "
-        "D.2-D.4 event times\n",
-        tdmReferences(sc, ts.integrator, false));
+        "D.2-D.4 event times{}\n",
+        tdmReferences(sc, ts.integrator, false),
+        world.surfaces.empty() ? "" : ", D.8 mesh walls, H.6 walls the event-driven part leaves to the time-driven");
 }
 
 static void describeMethod(const Scenario& sc, std::ostream& out) {

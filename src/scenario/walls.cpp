@@ -324,20 +324,55 @@ void boundsOf(const WallDef& w, int dim, Vec3d& lo, Vec3d& hi) {
 
 }  // namespace
 
+namespace {
+
+/// What a pure event-driven run can predict (docs/physics.md H.6): planes at a constant velocity (D.3) and static
+/// walls made of segments or triangles (D.8). Anything else is the hybrid's (whose guard hands the particles near it
+/// to the time-driven engine) or the time-driven engine's.
+void checkEventDriven(const WallDef& w, const std::string& key) {
+    const std::string use =
+        "; use method = \"haet\" (its time-driven part takes the particles near such a wall) or "
+        "method = \"tdm\"";
+    const bool meshLike = w.type == WallType::Plane || w.type == WallType::Segment || w.type == WallType::Polyline ||
+                          w.type == WallType::Mesh || w.type == WallType::Rectangle;
+    if (!meshLike) {
+        std::string type;
+        for (const TypeInfo& t : kTypes)
+            if (t.type == w.type) type = std::string(t.name);
+        throw ScenarioError(w.pos, key + ".type",
+                            "a " + inQuotes(type) +
+                                " wall is curved: the event-driven engine predicts planes and walls made of "
+                                "segments or triangles only" +
+                                use);
+    }
+    if (w.isPlane()) {
+        if (w.frequency != 0)
+            throw ScenarioError(w.pos, key + ".oscillation",
+                                "an oscillating plane: the event-driven engine predicts planes at a constant "
+                                "velocity only" +
+                                    use);
+        return;
+    }
+    const char* motion = w.rotates()             ? ".rotation"
+                         : w.frequency != 0      ? ".oscillation"
+                         : norm3(w.velocity) > 0 ? ".velocity"
+                                                 : nullptr;
+    if (motion)
+        throw ScenarioError(w.pos, key + motion,
+                            "a moving wall of segments or triangles: the event-driven engine predicts them only at "
+                            "rest" +
+                                use);
+}
+
+}  // namespace
+
 void checkWalls(const Scenario& s) {
     bool polygons = false;
     for (const InsertDef& in : s.inserts) polygons = polygons || in.shape == ShapeKind::Polygon;
     for (std::size_t q = 0; q < s.walls.size(); ++q) {
         const WallDef& w = s.walls[q];
         const std::string key = "walls[" + std::to_string(q + 1) + "]";
-        if (!w.isPlane() && s.method != Method::Tdm)
-            throw ScenarioError(w.pos, key + ".type",
-                                "walls other than planes need method = \"tdm\": the event-driven engine predicts "
-                                "collisions with planes only, and \"haet\" hands particles to it");
-        if (w.isPlane() && w.frequency != 0 && s.method != Method::Tdm)
-            throw ScenarioError(w.pos, key + ".oscillation",
-                                "an oscillating plane needs method = \"tdm\" (the event-driven engine predicts "
-                                "planes moving at a constant velocity)");
+        if (s.method == Method::Edm) checkEventDriven(w, key);
         // Polygons (2D) touch every 2D wall (docs/physics.md G.6); the 3D shapes are rejected for 2D scenes anyway.
         const bool polygonWall = w.isPlane() || w.type == WallType::Segment || w.type == WallType::Polyline ||
                                  w.type == WallType::Circle || w.type == WallType::Arc;

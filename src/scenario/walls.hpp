@@ -14,10 +14,10 @@ namespace haet {
 /// resolved against `dir`.
 WallDef readWall(const TableReader& r, int dim, int material, const std::filesystem::path& dir);
 
-/// What the walls need of the rest of the scenario: the method (pure event-driven runs predict planes only; the
-/// hybrid hands its particles to the event-driven engine, so it takes planes only too), the particles (polygons
-/// touch the 2D walls: planes, segments, polylines, circles, arcs), a shape within reach of the domain. Throws
-/// ScenarioError naming the wall.
+/// What the walls need of the rest of the scenario: the method (pure event-driven runs predict planes at a constant
+/// velocity and static walls of segments or triangles only; the hybrid and the time-driven engine take every wall),
+/// the particles (polygons touch the 2D walls: planes, segments, polylines, circles, arcs), a shape within reach of
+/// the domain. Throws ScenarioError naming the wall.
 void checkWalls(const Scenario& s);
 
 /// The runtime wall of a plane's definition (time 0), and of any other shape's (its elements, motion, material).
