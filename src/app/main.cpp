@@ -1,5 +1,6 @@
-// The `haet` command line: run and check scenarios, plot CSV tables. Exit codes: 0 ok, 2 bad input, 3 simulation blew
-// up.
+// The `haet` command line: run and check scenarios, plot CSV tables. Exit codes (docs/scenario.md, "Running"): 0 ok,
+// 1 an unexpected failure, 2 bad input, 3 the simulation blew up, 4 an output could not be written, 130 / 143 a run
+// stopped by SIGINT / SIGTERM.
 #include <malloc.h>
 
 #include <CLI/CLI.hpp>
@@ -27,7 +28,7 @@ int main(int argc, char** argv) {
     std::string runFile, outDir;
     std::vector<std::string> sets;  // --set KEY=VALUE of `run` or `check`, in order
     int threads = 0;
-    bool quiet = false;
+    bool quiet = false, progress = false;
     const std::string setHelp =
         "override a value of the scenario, KEY=VALUE with a TOML value (tdm.dt=1e-5, insert[2].count=500); "
         "repeatable";
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
     run->add_option("--out", outDir, "output directory (default: [output] directory of the scenario)");
     run->add_option("--threads", threads, "number of threads (default: all cores)")->check(CLI::NonNegativeNumber);
     run->add_flag("--quiet,-q", quiet, "no progress bar or summary");
+    run->add_flag("--progress", progress, "show the progress line even when stderr is not a terminal");
     // One value per --set, so that the scenario may follow it.
     run->add_option("--set", sets, setHelp)
         ->expected(1)
@@ -72,7 +74,9 @@ int main(int argc, char** argv) {
     try {
         if (*run) {
             const haet::Scenario sc = haet::loadScenario(runFile, sets);
-            haet::RunOptions opt{outDir, threads, quiet};
+            haet::RunOptions opt{outDir, threads, quiet,
+                                 progress ? haet::ProgressDisplay::On
+                                          : (quiet ? haet::ProgressDisplay::Off : haet::ProgressDisplay::Auto)};
             return static_cast<int>(haet::runScenario(sc, opt, std::cerr));
         }
         if (*plot) {
@@ -107,8 +111,8 @@ int main(int argc, char** argv) {
         std::cerr << "error: " << e.what() << "\n";
         return 2;
     } catch (const haet::IoError& e) {
-        std::cerr << "error: " << e.what() << "\n";
-        return 1;
+        std::cerr << "error: cannot write an output: " << e.what() << "\n";
+        return static_cast<int>(haet::RunStatus::OutputFailed);
     } catch (const std::exception& e) {
         std::cerr << "error: " << e.what() << "\n";
         return 1;

@@ -107,7 +107,7 @@ double HaetEngine<D>::eventCellEdge(std::size_t nT) const {
 
 template <int D>
 void HaetEngine<D>::step() {
-    const double t1 = w_.time + ts_.dt;
+    const double t1 = tdm_->timeAfter(1);  // where the time-driven step ends, bit for bit
     edm_->advanceEvents(t1);
     const std::uint64_t rebuilds = tdm_->rebuilds();
     tdm_->step();
@@ -136,7 +136,10 @@ void HaetEngine<D>::step() {
 
 template <int D>
 void HaetEngine<D>::advanceTo(double t) {
-    while (w_.time + 0.5 * ts_.dt <= t) step();
+    while (w_.time + 0.5 * ts_.dt <= t) {
+        step();
+        if (hs_.stop && hs_.stop->load(std::memory_order_relaxed)) return;  // after a whole step
+    }
 }
 
 template <int D>

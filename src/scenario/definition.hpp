@@ -74,6 +74,7 @@ struct TdmDef {
     double maxOverlap = 0.5;       ///< blow-up: stop when overlap / smaller radius exceeds this [-]
     int sortEvery = 1000;          ///< spatial re-sort of particles every N steps (0 = never)
     SourcePos pos;
+    SourcePos dtPos;  ///< where dt was given (the table's line when it was not)
 };
 
 enum class EdmTangential { Walton, Constant };
@@ -136,6 +137,10 @@ struct OutputDef {
     double snapshotPeriod = 0;      ///< [s] between snapshots; 0 = 1/20 of duration; < 0 = none
     SourcePos pos;
 };
+
+/// Bounds on what a run writes (docs/scenario.md, [output]): a period that asks for more is an error.
+inline constexpr double kMaxSeriesRows = 1e7;
+inline constexpr double kMaxSnapshots = 1e5;
 
 struct Scenario {
     std::string path;  ///< scenario file

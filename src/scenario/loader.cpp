@@ -412,12 +412,16 @@ private:
                                                 {{"verlet", IntegratorKind::Verlet}, {"gear5", IntegratorKind::Gear5}})
                            .value_or(IntegratorKind::Verlet);
         t.integratorGiven = r.has("integrator");
+        t.dtPos = r.posOf("dt");
         if (const toml::node* n = r.table().get("dt")) {
             if (const auto* str = n->as_string()) {
                 if (str->get() != "auto") r.fail("dt", "must be \"auto\" or a number > 0");
             } else if (n->is_number()) {
                 t.dt = r.number("dt");
                 if (!(*t.dt > 0)) r.fail("dt", "must be > 0");
+                if (*t.dt > s.duration)
+                    r.fail("dt", "the time step " + formatNumber(*t.dt) + " s is longer than the duration " +
+                                     formatNumber(s.duration) + " s: the run would take no step");
             } else {
                 r.fail("dt", "expected a number or \"auto\"");
             }
@@ -688,6 +692,21 @@ private:
         o.seriesPeriod = r.number("series_period").value_or(o.seriesPeriod);
         if (!(o.seriesPeriod >= 0)) r.fail("series_period", "must be >= 0");
         o.snapshotPeriod = r.number("snapshot_period").value_or(o.snapshotPeriod);
+        checkOutputCounts(r, s);
+    }
+
+    /// A period that would write more rows or snapshots than a run can keep (series.csv is held in memory and
+    /// rewritten whole, so that it is always complete on disk) is an error, not hours of output at t = 0.
+    void checkOutputCounts(const TableReader& r, const Scenario& s) const {
+        const OutputDef& o = s.output;
+        if (o.seriesPeriod > 0 && s.duration / o.seriesPeriod > kMaxSeriesRows)
+            r.fail("series_period", formatNumber(o.seriesPeriod) + " s asks for " +
+                                        formatNumber(std::floor(s.duration / o.seriesPeriod)) + " rows over " +
+                                        formatNumber(s.duration) + " s; at most " + formatNumber(kMaxSeriesRows));
+        if (o.snapshotPeriod > 0 && s.duration / o.snapshotPeriod > kMaxSnapshots)
+            r.fail("snapshot_period", formatNumber(o.snapshotPeriod) + " s asks for " +
+                                          formatNumber(std::floor(s.duration / o.snapshotPeriod)) + " snapshots over " +
+                                          formatNumber(s.duration) + " s; at most " + formatNumber(kMaxSnapshots));
     }
 
     TableReader root_;
@@ -845,10 +864,29 @@ Scenario parseScenario(std::string_view text, const std::filesystem::path& file,
 }
 
 Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+    return parseScenario(readScenarioText(file), file, overrides);
+}
+
+std::string readScenarioText(const std::filesystem::path& file) {
+    const SourcePos pos{file.string(), 0};
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) throw ScenarioError(pos, "", "is a directory, not a scenario file");
     std::ifstream in(file, std::ios::binary);
-    if (!in) throw ScenarioError({file.string(), 0}, "", "cannot open the scenario file");
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    return parseScenario(text, file, overrides);
+    if (!in) throw ScenarioError(pos, "", "cannot open the scenario file");
+    // Read in pieces up to a bound: a device (/dev/zero) or a runaway pipe must not take all memory.
+    std::string text;
+    char buf[65536];
+    while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+        text.append(buf, static_cast<std::size_t>(in.gcount()));
+        if (text.size() > kMaxScenarioBytes)
+            throw ScenarioError(pos, "",
+                                "longer than " + std::to_string(kMaxScenarioBytes >> 20) +
+                                    " MiB: not a scenario file (particles belong in an [[insert]] file)");
+    }
+    if (in.bad()) throw ScenarioError(pos, "", "cannot read the scenario file");
+    if (text.find('\0') != std::string::npos)
+        throw ScenarioError(pos, "", "holds NUL bytes: not a text file, not a scenario");
+    return text;
 }
 
 }  // namespace haet

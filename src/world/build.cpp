@@ -66,6 +66,32 @@ World<D> buildWorld(const Scenario& sc) {
     return w;
 }
 
+/// The time step against the contact duration and the run's length: a hand-set dt beyond t_c leaves every contact
+/// unresolved (velocity Verlet is unstable from dt = 2 t_c / pi on, docs/physics.md F.2) and makes the kick that
+/// blows a system up; a step longer than the run takes no step at all.
+static void checkTimeStep(const Scenario& sc, double dt, double contactTime, bool polygons) {
+    auto fmtNum = [](double v) {
+        std::ostringstream os;
+        os << v;
+        return os.str();
+    };
+    if (!(dt > 0 && dt < 1e300))  // a contact duration that overflowed (a radius of 1e300 m from a file)
+        throw ScenarioError(sc.tdm.dtPos, "tdm.dt",
+                            "the time step " + fmtNum(dt) + " s is not a usable number (check the particle sizes)");
+    if (sc.tdm.dt && !polygons && contactTime > 0 && dt > contactTime)
+        throw ScenarioError(sc.tdm.dtPos, "tdm.dt",
+                            "the time step " + fmtNum(dt) +
+                                " s is longer than the contact duration t_c = " + fmtNum(contactTime) +
+                                " s: contacts are not resolved and a touch becomes a kick "
+                                "(give dt <= t_c / 10, or dt = \"auto\")");
+    if (dt > sc.duration)
+        throw ScenarioError(sc.tdm.dtPos, sc.tdm.dt ? "tdm.dt" : "tdm.steps_per_contact",
+                            "the time step " + fmtNum(dt) + " s (" +
+                                (sc.tdm.dt ? "given" : "auto: t_c / " + fmtNum(sc.tdm.stepsPerContact)) +
+                                ") is longer than the duration " + fmtNum(sc.duration) +
+                                " s: the run would take no step");
+}
+
 template <int D>
 TdmSettings tdmSettings(const Scenario& sc, const World<D>& w, std::string* dtNote) {
     TdmSettings s;
@@ -98,6 +124,7 @@ TdmSettings tdmSettings(const Scenario& sc, const World<D>& w, std::string* dtNo
         note << "auto: t_c / " << sc.tdm.stepsPerContact << " (" << w.contact.contactTimeNote << ")";
     }
     if (dtNote) *dtNote = note.str();
+    checkTimeStep(sc, s.dt, w.contact.contactTime, polygons > 0);
     double dmax = 0;
     for (double r : w.particles.radius) dmax = std::max(dmax, 2 * r);
     // Default skin: a tenth of the largest diameter (LAMMPS granular inputs typically use 0.1 d).
