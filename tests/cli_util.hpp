@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -61,6 +62,31 @@ protected:
         r.out = read(out);
         r.err = read(err);
         return r;
+    }
+
+    /// Starts `haet ARGS` as a child process, its stdout and stderr to files in the test's directory; returns its
+    /// pid for signals and wait().
+    pid_t spawn(const std::vector<std::string>& args) {
+        const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+        std::vector<std::string> argv = {HAET_BINARY};
+        argv.insert(argv.end(), args.begin(), args.end());
+        const pid_t pid = fork();
+        if (pid == 0) {
+            std::freopen(out.c_str(), "w", stdout);
+            std::freopen(err.c_str(), "w", stderr);
+            std::vector<char*> a;
+            for (std::string& s : argv) a.push_back(s.data());
+            a.push_back(nullptr);
+            execv(a[0], a.data());
+            _exit(127);
+        }
+        return pid;
+    }
+    /// Waits for a child of spawn(): its exit code, or 128 + the signal that killed it (as a shell reports it).
+    static int wait(pid_t pid) {
+        int status = 0;
+        waitpid(pid, &status, 0);
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     }
 
     fs::path write(const std::string& name, const std::string& text) {
