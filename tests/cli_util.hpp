@@ -70,6 +70,8 @@ protected:
         const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
         std::vector<std::string> argv = {HAET_BINARY};
         argv.insert(argv.end(), args.begin(), args.end());
+        std::fflush(stdout);  // or the child's freopen writes the parent's buffered output a second time
+        std::fflush(stderr);
         const pid_t pid = fork();
         if (pid == 0) {
             std::freopen(out.c_str(), "w", stdout);

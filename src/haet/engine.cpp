@@ -25,6 +25,10 @@ HaetSettings resolved(const World<D>& w, HaetSettings hs) {
     if (!(hs.zones.size > 0)) hs.zones.size = 4 * d;
     hs.zones.size = std::max(hs.zones.size, d);
     if (!(hs.zones.size > 0)) hs.zones.size = 1;
+    // At most max(2^20, 8 N) zones: grains of 10 um in a box of 2 cm would otherwise make 249^3 zones (1 GB); the
+    // zones then grow, each still holding few particles.
+    const double maxZones = std::max(1048576.0, 8.0 * static_cast<double>(w.particles.size()));
+    hs.zones.size = CellGrid<D>::cappedEdge(w.domain.lo, w.domain.hi, hs.zones.size, maxZones);
     hs.relabelEvery = std::max(1, hs.relabelEvery);
     hs.diluteSteps = std::max(0, hs.diluteSteps);
     return hs;

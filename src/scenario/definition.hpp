@@ -52,6 +52,7 @@ struct DomainDef {
     Vec3d hi{1, 1, 1};                                  ///< upper corner [m]
     std::array<bool, 3> periodic{false, false, false};  ///< periodic per axis
     Vec3d gravity{0, 0, 0};                             ///< [m/s^2]
+    SourcePos pos;                                      ///< the [domain] table
 };
 
 /// A [materials.NAME] table: the properties the contact laws read (contact/model.hpp) and where they were set.
@@ -87,6 +88,7 @@ struct EdmDef {
     std::optional<double> tcTime;    ///< TC time [s]; default: the soft contact duration t_c
     std::optional<double> cellSize;  ///< event grid cell edge [m]; default: the largest diameter
     SourcePos pos;
+    SourcePos cellPos;  ///< where cell_size was given
 };
 
 /// The hybrid (method = "haet"), docs/physics.md A: TDM where the local volume fraction is high, EDM where low.

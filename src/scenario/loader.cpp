@@ -8,11 +8,13 @@
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <utility>
 #include <vector>
 
+#include "scenario/checks.hpp"
 #include "scenario/text.hpp"
 
 namespace haet {
@@ -243,6 +245,7 @@ public:
         readInserts(s);
         checkDiskLaw(s);
         readOutput(s);
+        checkScenario(s);  // the checks across tables (scenario/checks.hpp)
         return s;
     }
 
@@ -279,6 +282,7 @@ private:
         const TableReader r = child("domain");
         r.allowOnly({"lo", "hi", "periodic", "gravity"});
         DomainDef& d = s.domain;
+        d.pos = r.tablePos();
         d.lo = r.requiredVector("lo", dim_);
         d.hi = r.requiredVector("hi", dim_);
         for (int k = 0; k < dim_; ++k)
@@ -317,8 +321,10 @@ private:
             if (!(m.young > 0)) r.fail("young", "must be > 0");
             m.poisson = r.number("poisson").value_or(m.poisson);
             if (!(m.poisson > -1 && m.poisson < 0.5)) r.fail("poisson", "must satisfy -1 < poisson < 0.5");
-            m.restitution = r.requiredNumber("restitution");
-            if (!(m.restitution > 0 && m.restitution <= 1)) r.fail("restitution", "must satisfy 0 < e <= 1");
+            // Optional where nothing reads it (the linear law with kn and gamma_n, checkRestitution).
+            m.restitution = r.number("restitution").value_or(kRestitutionUnset);
+            if (r.has("restitution") && !(m.restitution > 0 && m.restitution <= 1))
+                r.fail("restitution", "must satisfy 0 < e <= 1");
             m.friction = r.requiredNumber("friction");
             if (!(m.friction >= 0)) r.fail("friction", "must be >= 0");
             m.tangentialRestitution = r.number("tangential_restitution").value_or(m.tangentialRestitution);
@@ -451,6 +457,7 @@ private:
         e.tcTime = r.number("tc_time");
         if (e.tcTime && !(*e.tcTime > 0)) r.fail("tc_time", "must be > 0");
         e.cellSize = r.number("cell_size");
+        e.cellPos = r.posOf("cell_size");
         if (e.cellSize && !(*e.cellSize > 0)) r.fail("cell_size", "must be > 0");
     }
 
@@ -491,9 +498,12 @@ private:
             w.pos = r.tablePos();
             w.point = r.requiredVector("point", dim_);
             w.normal = r.requiredVector("normal", dim_);
+            // Scaled by its largest component first: [1e200, 1e200] squared overflows, [1e-200, 1e-200] underflows.
+            const double big = std::max({std::abs(w.normal[0]), std::abs(w.normal[1]), std::abs(w.normal[2])});
+            if (!(big > 0)) r.fail("normal", "must be nonzero");
+            for (double& c : w.normal) c /= big;
             const double len =
                 std::sqrt(w.normal[0] * w.normal[0] + w.normal[1] * w.normal[1] + w.normal[2] * w.normal[2]);
-            if (!(len > 0)) r.fail("normal", "must be nonzero");
             for (double& c : w.normal) c /= len;
             w.material = materialIndex(r, "material");
             w.velocity = r.vector("velocity", dim_).value_or(Vec3d{0, 0, 0});
@@ -865,28 +875,6 @@ Scenario parseScenario(std::string_view text, const std::filesystem::path& file,
 
 Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
     return parseScenario(readScenarioText(file), file, overrides);
-}
-
-std::string readScenarioText(const std::filesystem::path& file) {
-    const SourcePos pos{file.string(), 0};
-    std::error_code ec;
-    if (std::filesystem::is_directory(file, ec)) throw ScenarioError(pos, "", "is a directory, not a scenario file");
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw ScenarioError(pos, "", "cannot open the scenario file");
-    // Read in pieces up to a bound: a device (/dev/zero) or a runaway pipe must not take all memory.
-    std::string text;
-    char buf[65536];
-    while (in.read(buf, sizeof buf) || in.gcount() > 0) {
-        text.append(buf, static_cast<std::size_t>(in.gcount()));
-        if (text.size() > kMaxScenarioBytes)
-            throw ScenarioError(pos, "",
-                                "longer than " + std::to_string(kMaxScenarioBytes >> 20) +
-                                    " MiB: not a scenario file (particles belong in an [[insert]] file)");
-    }
-    if (in.bad()) throw ScenarioError(pos, "", "cannot read the scenario file");
-    if (text.find('\0') != std::string::npos)
-        throw ScenarioError(pos, "", "holds NUL bytes: not a text file, not a scenario");
-    return text;
 }
 
 }  // namespace haet

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/rng.hpp"
+#include "scenario/checks.hpp"
 #include "scenario/insert.hpp"
 
 namespace haet {
@@ -32,10 +33,43 @@ std::vector<MaterialStats> materialStats(const Particles<D>& p, int nMaterials) 
     return st;
 }
 
+/// The materials a run can bring into contact: those of its particles, its walls and its inserts (a source of
+/// particles that adds them later must list its material here too). Only their pairs are calibrated.
+static std::vector<bool> usedMaterials(const Scenario& sc, const std::vector<MaterialStats>& stats) {
+    std::vector<bool> used(sc.materials.size(), false);
+    for (std::size_t m = 0; m < stats.size() && m < used.size(); ++m) used[m] = stats[m].count > 0;
+    for (const WallDef& w : sc.walls) used[w.material] = true;
+    for (const InsertDef& in : sc.inserts) used[in.material] = true;
+    return used;
+}
+
+/// A reference head-on collision that does not end, or overlaps by more than the effective radius, means a contact
+/// law the scene's speeds break (Hertz with a tiny Young's modulus at impact_velocity): bad input, named.
+static void checkHeadOn(const Scenario& sc, const ContactSetup& cs) {
+    const ContactSetup::WorstHeadOn& w = cs.worstHeadOn;
+    if (w.a < 0 || w.overlapRatio <= 1) return;
+    const bool hertz = sc.contact.normal == NormalLaw::Hertz;
+    if (!hertz && std::isfinite(w.overlapRatio)) return;  // the linear law's t_c is the user's; its e still holds
+    const MaterialDef& m = sc.materials[w.a];
+    std::ostringstream os;
+    os << "a head-on collision of " << m.name << " with " << sc.materials[w.b].name << " at impact_velocity "
+       << sc.contact.impactVelocity << " m/s ";
+    if (std::isfinite(w.overlapRatio))
+        os << "overlaps by " << w.overlapRatio << " effective radii: the modulus is too small for contacts at this "
+           << "speed (Hertz needs overlaps well below the radius, docs/physics.md B.3)";
+    else
+        os << "does not end or is not finite: the contact law cannot be calibrated (docs/physics.md B.3)";
+    throw ScenarioError(hertz ? m.pos : sc.contact.pos,
+                        hertz ? "materials." + m.name + ".young" : std::string("contact"), os.str());
+}
+
 template <int D>
 ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialStats>& stats) {
     const std::vector<MaterialProps> props(sc.materials.begin(), sc.materials.end());
-    return buildContactSetup<D>(static_cast<const ContactModelDef&>(sc.contact), props, stats);
+    ContactSetup cs =
+        buildContactSetup<D>(static_cast<const ContactModelDef&>(sc.contact), props, stats, usedMaterials(sc, stats));
+    checkHeadOn(sc, cs);
+    return cs;
 }
 
 template <int D>
@@ -62,6 +96,7 @@ World<D> buildWorld(const Scenario& sc) {
         w.walls.push_back(wall);
     }
     insertParticles<D>(sc, w.particles, Rng(sc.seed, RngStream::Insert));
+    checkParticles<D>(sc, w.particles);  // what the engines cannot run, with the key (scenario/checks.hpp)
     w.contact = buildContactSetup<D>(sc, materialStats(w.particles, static_cast<int>(sc.materials.size())));
     return w;
 }
