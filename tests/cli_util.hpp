@@ -64,9 +64,9 @@ protected:
         return r;
     }
 
-    /// Starts `haet ARGS` as a child process, its stdout and stderr to files in the test's directory; returns its
-    /// pid for signals and wait().
-    pid_t spawn(const std::vector<std::string>& args) {
+    /// Starts `haet ARGS` as a child process, its stdout and stderr to files in the test's directory, with the
+    /// environment changed by `env`; returns its pid for signals and wait().
+    pid_t spawn(const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
         const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
         std::vector<std::string> argv = {HAET_BINARY};
         argv.insert(argv.end(), args.begin(), args.end());
@@ -76,6 +76,11 @@ protected:
         if (pid == 0) {
             std::freopen(out.c_str(), "w", stdout);
             std::freopen(err.c_str(), "w", stderr);
+            for (const std::string& e : env)  // NAME=VALUE sets, NAME alone unsets
+                if (e.find('=') == std::string::npos)
+                    unsetenv(e.c_str());
+                else
+                    setenv(e.substr(0, e.find('=')).c_str(), e.substr(e.find('=') + 1).c_str(), 1);
             std::vector<char*> a;
             for (std::string& s : argv) a.push_back(s.data());
             a.push_back(nullptr);
