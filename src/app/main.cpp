@@ -1,8 +1,11 @@
-// The `haet` command line: run and check scenarios, plot CSV tables. Exit codes: 0 ok, 2 bad input, 3 simulation blew
-// up.
+// The `haet` command line: run and check scenarios, plot CSV tables. Exit codes (docs/scenario.md, "Running"): 0 ok,
+// 1 an unexpected failure, 2 bad input, 3 the simulation blew up, 4 an output could not be written, 130 / 143 a run
+// stopped by SIGINT / SIGTERM.
 #include <malloc.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cstdlib>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -14,7 +17,22 @@
 #include "run/runner.hpp"
 #include "scenario/loader.hpp"
 
+namespace {
+
+/// OpenMP threads that wait by spinning starve the other work of a shared, loaded machine and each other: the hybrid
+/// demo took 364 s of wall time on two threads beside a competing load, 63 s on one, and 44 s on two with passive
+/// waiting (a waiting thread sleeps at once). libgomp reads OMP_WAIT_POLICY when it is loaded, before main, so the
+/// program sets it (unless the user has) and executes itself again; the same process, pid and arguments.
+void passiveOpenMpWaiting(char** argv) {
+    if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
+    if (setenv("OMP_WAIT_POLICY", "passive", 0) != 0) return;
+    execv("/proc/self/exe", argv);  // returns only if it failed: then run on as before
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+    passiveOpenMpWaiting(argv);
     // Large buffers (pair lists rebuilt every ~100 steps, file contents at set-up) go straight to the system
     // and back when freed. By default glibc raises this threshold to the size of the last freed buffer, after
     // which buffers come from the heap and the freed ones stay resident (3D chute benchmark, 1 500 steps: peak
@@ -27,7 +45,7 @@ int main(int argc, char** argv) {
     std::string runFile, outDir;
     std::vector<std::string> sets;  // --set KEY=VALUE of `run` or `check`, in order
     int threads = 0;
-    bool quiet = false;
+    bool quiet = false, progress = false;
     const std::string setHelp =
         "override a value of the scenario, KEY=VALUE with a TOML value (tdm.dt=1e-5, insert[2].count=500); "
         "repeatable";
@@ -36,6 +54,7 @@ int main(int argc, char** argv) {
     run->add_option("--out", outDir, "output directory (default: [output] directory of the scenario)");
     run->add_option("--threads", threads, "number of threads (default: all cores)")->check(CLI::NonNegativeNumber);
     run->add_flag("--quiet,-q", quiet, "no progress bar or summary");
+    run->add_flag("--progress", progress, "show the progress line even when stderr is not a terminal");
     // One value per --set, so that the scenario may follow it.
     run->add_option("--set", sets, setHelp)
         ->expected(1)
@@ -72,7 +91,9 @@ int main(int argc, char** argv) {
     try {
         if (*run) {
             const haet::Scenario sc = haet::loadScenario(runFile, sets);
-            haet::RunOptions opt{outDir, threads, quiet};
+            haet::RunOptions opt{outDir, threads, quiet,
+                                 progress ? haet::ProgressDisplay::On
+                                          : (quiet ? haet::ProgressDisplay::Off : haet::ProgressDisplay::Auto)};
             return static_cast<int>(haet::runScenario(sc, opt, std::cerr));
         }
         if (*plot) {
@@ -107,8 +128,8 @@ int main(int argc, char** argv) {
         std::cerr << "error: " << e.what() << "\n";
         return 2;
     } catch (const haet::IoError& e) {
-        std::cerr << "error: " << e.what() << "\n";
-        return 1;
+        std::cerr << "error: cannot write an output: " << e.what() << "\n";
+        return static_cast<int>(haet::RunStatus::OutputFailed);
     } catch (const std::exception& e) {
         std::cerr << "error: " << e.what() << "\n";
         return 1;

@@ -42,6 +42,13 @@ struct ContactSetup {
     /// contactTime is the shorter of this and the polygons' pi sqrt(m_min/Y).
     double diskContactTime = 0;
 
+    /// The deepest of the reference head-on collisions (two mean particles of the materials at impact_velocity):
+    /// overlap / R_eff (infinite when a collision does not end or is not finite), and its material pair.
+    struct WorstHeadOn {
+        double overlapRatio = 0;
+        int a = -1, b = -1;
+    } worstHeadOn;
+
     const PairCoeffs& pair(int a, int b) const { return table[a * nMaterials + b]; }
     const polygon::PolygonCoeffs& polygonPair(int a, int b) const { return polygonTable[a * nMaterials + b]; }
 };
@@ -49,10 +56,12 @@ struct ContactSetup {
 /// Builds the coefficient table of particles in D dimensions from the contact laws, the materials (one entry per
 /// material, in the order of their indices) and the sizes of their particles (stats: one entry per material,
 /// count 0 for wall-only materials). Each law mixes the two materials' properties and derives its coefficients
-/// in its own set-up function (setup.cpp), with its own contact duration for the time-step rule.
+/// in its own set-up function (setup.cpp), with its own contact duration for the time-step rule. `used` (one
+/// entry per material; empty: all): only pairs of used materials get the head-on calibration and count for the
+/// contact duration; the others keep the mixed values (and restitution e_ab).
 template <int D>
 ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<MaterialProps>& materials,
-                               const std::vector<MaterialStats>& stats);
+                               const std::vector<MaterialStats>& stats, const std::vector<bool>& used = {});
 
 /// Result of integrating one head-on collision of the soft law (docs/physics.md B.2/B.3).
 struct HeadOnResult {

@@ -568,17 +568,26 @@ void EdmEngine<D>::advanceTo(double t) {
 }
 
 template <int D>
-void EdmEngine<D>::advanceEvents(double t) {
+double EdmEngine<D>::advanceEvents(double t) {
     if (s_.reference) throw std::logic_error("event-driven engine: advanceEvents in reference mode");
     if (s_.holdState && w_.particles.hasMotion()) w_.particles.releaseMotion();
+    double reached = t;
     try {
-        while (queue_.size() > 0 && queue_.topTime() < t) processNext();
+        while (queue_.size() > 0 && queue_.topTime() < t) {
+            const double now = queue_.topTime();
+            processNext();
+            if (s_.stop && s_.stop->load(std::memory_order_relaxed)) {
+                reached = std::max(now, w_.time);
+                break;
+            }
+        }
     } catch (...) {
         putBackState();
         throw;
     }
     // Particles diffuse away from their sorted neighbours; re-sort after ~20 events per particle.
     if (events_ - sortedAt_ > 20 * static_cast<std::uint64_t>(std::max<std::size_t>(nLive_, 1))) resort();
+    return reached;
 }
 
 // ---------------------------------------------------------------------------------------------------------------

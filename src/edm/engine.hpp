@@ -15,6 +15,7 @@
 // canonical times edm/mesh_walls.hpp; the TC model edm/tc_model.hpp; the reference twin edm/reference.hpp; a
 // coupled engine (the hybrid) follows the particles through edm/observer.hpp.
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <utility>
@@ -75,6 +76,9 @@ struct EdmSettings {
     /// oscillating planes) belong to a coupled engine, which keeps this engine's particles away from them (the
     /// hybrid's guard, docs/haet.md): they are left out. false: such a wall is an error (std::invalid_argument).
     bool guardedWalls = false;
+    /// Set from outside (a signal handler: run/stop.hpp) to end advanceEvents after the event under way; null:
+    /// never. A hybrid leaves it null (its own steps stop).
+    const std::atomic<bool>* stop = nullptr;
 };
 
 /// One collision as seen by an observer (tests, diagnostics).
@@ -126,7 +130,9 @@ public:
     /// Processes all events before t without bringing the particles to t (their clocks stay where their last
     /// event left them); the World's copy of this engine's particles is stale (with EdmSettings::holdState: absent)
     /// until synchronise(). If it throws, a held state is put back as it is, each particle at its own clock.
-    void advanceEvents(double t);
+    /// Returns t, or, when EdmSettings::stop ended it early, the time of the last event processed (no event is
+    /// pending before it, so every particle can be synchronised there).
+    double advanceEvents(double t);
     /// Brings every particle of this engine to time t and writes its state to the World; world.time = t.
     /// With EdmSettings::holdState it also gives the World back its positions, velocities and radii.
     void synchronise(double t);

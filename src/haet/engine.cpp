@@ -25,6 +25,10 @@ HaetSettings resolved(const World<D>& w, HaetSettings hs) {
     if (!(hs.zones.size > 0)) hs.zones.size = 4 * d;
     hs.zones.size = std::max(hs.zones.size, d);
     if (!(hs.zones.size > 0)) hs.zones.size = 1;
+    // At most max(2^20, 8 N) zones: grains of 10 um in a box of 2 cm would otherwise make 249^3 zones (1 GB); the
+    // zones then grow, each still holding few particles.
+    const double maxZones = std::max(1048576.0, 8.0 * static_cast<double>(w.particles.size()));
+    hs.zones.size = CellGrid<D>::cappedEdge(w.domain.lo, w.domain.hi, hs.zones.size, maxZones);
     hs.relabelEvery = std::max(1, hs.relabelEvery);
     hs.diluteSteps = std::max(0, hs.diluteSteps);
     return hs;
@@ -111,7 +115,7 @@ double HaetEngine<D>::eventCellEdge(std::size_t nT) const {
 
 template <int D>
 void HaetEngine<D>::step() {
-    const double t1 = w_.time + ts_.dt;
+    const double t1 = tdm_->timeAfter(1);  // where the time-driven step ends, bit for bit
     edm_->advanceEvents(t1);
     const std::uint64_t rebuilds = tdm_->rebuilds();
     tdm_->step();
@@ -140,7 +144,10 @@ void HaetEngine<D>::step() {
 
 template <int D>
 void HaetEngine<D>::advanceTo(double t) {
-    while (w_.time + 0.5 * ts_.dt <= t) step();
+    while (w_.time + 0.5 * ts_.dt <= t) {
+        step();
+        if (hs_.stop && hs_.stop->load(std::memory_order_relaxed)) return;  // after a whole step
+    }
 }
 
 template <int D>

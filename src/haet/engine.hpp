@@ -31,6 +31,8 @@ struct HaetSettings {
     double dtMin = 0;        ///< modified EDM (A.4): a collision within dtMin of the particle's previous one hands
                              ///< both particles to the TDM [s]; 0: the contact duration
     double radiusBound = 0;  ///< the largest radius of particles added later (inlets) [m]; 0: those at the start
+    /// Set from outside (a signal handler: run/stop.hpp) to end advanceTo after the step under way; null: never.
+    const std::atomic<bool>* stop = nullptr;
 };
 
 /// Where the energy went, since the start [J]. Potential energy is that of gravity, -m g.x (unwrapped x).

@@ -111,9 +111,13 @@ void writePng(const std::filesystem::path& path, const PngScene& scene) {
     const double spanX = scene.hi[0] - scene.lo[0];
     const double spanY = scene.hi[1] - scene.lo[1];
     if (!(spanX > 0 && spanY > 0)) throw std::invalid_argument(path.string() + ": empty view (hi <= lo)");
-    const double scale = scene.widthPx / spanX;  // [px/m]
+    // A view taller than kMaxPx at the asked width (a 2D domain of more than 18 widths) is drawn narrower.
+    int widthPx = scene.widthPx;
+    if (spanY / spanX * widthPx > kMaxPx) widthPx = std::max(1, static_cast<int>(std::floor(kMaxPx * spanX / spanY)));
+    const double scale = widthPx / spanX;  // [px/m]
     const double heightPx = std::round(spanY * scale);
-    Canvas canvas = makeCanvas(path, scene.widthPx, static_cast<int>(std::clamp(heightPx, 1.0, kMaxPx + 1.0)));
+    Canvas canvas = makeCanvas(path, widthPx, static_cast<int>(std::clamp(heightPx, 1.0, double(kMaxPx))));
+    const double reach = 4.0 * std::max(widthPx, kMaxPx);  // beyond this a disk covers the picture [px]
     cairo_t* cr = canvas.cr.get();
     auto px = [&](double x) { return (x - scene.lo[0]) * scale; };
     auto py = [&](double y) { return (scene.hi[1] - y) * scale; };
@@ -131,7 +135,10 @@ void writePng(const std::filesystem::path& path, const PngScene& scene) {
         cairo_stroke(cr);
     }
     for (const PngScene::Disk& d : scene.disks) {
-        const double rPx = d.r * scale;
+        // A state that blew up (or a radius of 1e300 m) is drawn as far as it can be, never as an endless arc.
+        if (!std::isfinite(px(d.x)) || !std::isfinite(py(d.y)) || !(d.r >= 0)) continue;
+        if (std::abs(px(d.x)) > reach || std::abs(py(d.y)) > reach) continue;
+        const double rPx = std::min(d.r * scale, reach);
         cairo_new_sub_path(cr);
         cairo_arc(cr, px(d.x), py(d.y), rPx, 0, 2 * kPi);
         setColor(cr, d.rgb);
@@ -156,7 +163,7 @@ void writePng(const std::filesystem::path& path, const PngScene& scene) {
 
     if (!scene.caption.empty()) {
         cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-        cairo_set_font_size(cr, std::clamp(scene.widthPx / 50.0, 10.0, 24.0));
+        cairo_set_font_size(cr, std::clamp(widthPx / 50.0, 10.0, 24.0));
         cairo_text_extents_t e;
         cairo_text_extents(cr, scene.caption.c_str(), &e);
         const double pad = 4;

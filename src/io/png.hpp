@@ -34,8 +34,9 @@ struct PngScene {
     std::string caption;  ///< drawn at the top left (time, step count, ...)
 };
 
-/// Draws the scene on white with thin dark outlines. Throws std::invalid_argument for an empty view or an
-/// image larger than 16384 px on a side, IoError if the file cannot be written.
+/// Draws the scene on white with thin dark outlines. A view that would be taller than 16384 px at widthPx is drawn
+/// narrower (16384 px tall); disks with non-finite or far-away coordinates are left out. Throws
+/// std::invalid_argument for an empty view, IoError if the file cannot be written.
 void writePng(const std::filesystem::path& path, const PngScene& scene);
 
 /// One line of a plot. Points with a non-finite coordinate (or a non-positive one on a log axis) are

@@ -66,13 +66,29 @@ public:
     }
     /// The cells per axis of spanning(lo, hi, edge, ., unitFlatAxes), without building the grid (a caller that caps
     /// the number of cells tries edges whose product of cells may not fit in an int).
+    /// Each axis holds at most kMaxAxisCells cells (a fine edge over a huge box: the quotient would not fit an int).
     static std::array<int, D> spanningDims(const Vec<D>& lo, const Vec<D>& hi, double edge, bool unitFlatAxes = false) {
         std::array<int, D> n;
         for (int k = 0; k < D; ++k) {
             const double L = hi[k] - lo[k];
-            n[k] = unitFlatAxes && !(L > 0) ? 1 : std::max(1, static_cast<int>(std::floor(L / edge)));
+            const double q = std::min(std::floor(L / edge), double(kMaxAxisCells));
+            n[k] = unitFlatAxes && !(L > 0) ? 1 : std::max(1, static_cast<int>(q > 0 ? q : 0));
         }
         return n;
+    }
+    static constexpr int kMaxAxisCells = 1 << 30;
+    /// The smallest edge >= `edge` (in steps of 1.25) whose spanning grid has at most maxCells cells (counted in
+    /// double), so that a grid's size follows its particles, not its box: a periodic box of 1e6 m with cells of a
+    /// millimetre would hold more cells than an int counts.
+    static double cappedEdge(const Vec<D>& lo, const Vec<D>& hi, double edge, double maxCells,
+                             bool unitFlatAxes = false) {
+        maxCells = std::min(maxCells, double(1 << 30));
+        for (;; edge *= 1.25) {
+            const std::array<int, D> n = spanningDims(lo, hi, edge, unitFlatAxes);
+            double total = 1;
+            for (int k = 0; k < D; ++k) total *= n[k];
+            if (total <= maxCells) return edge;
+        }
     }
 
     int dim(int k) const { return n_[k]; }

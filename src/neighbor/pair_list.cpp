@@ -28,7 +28,9 @@ CellGrid<D> pairGrid(const Domain<D>& dom, double cellSize, const Particles<D>& 
         lo[k] = std::clamp(a, dom.lo[k], dom.hi[k]);
         hi[k] = std::max(std::clamp(b, dom.lo[k], dom.hi[k]), lo[k] + cellSize);
     }
-    return CellGrid<D>::spanning(lo, hi, cellSize, dom.periodic);
+    // At most max(2^20, 8 N) cells: a huge box with few particles gets larger cells, not more than an int counts.
+    const double maxCells = std::max(1048576.0, 8.0 * static_cast<double>(np));
+    return CellGrid<D>::spanning(lo, hi, CellGrid<D>::cappedEdge(lo, hi, cellSize, maxCells), dom.periodic);
 }
 
 /// The neighbour cells of a cell, each with the image-shift code of its particles, computed for one cell at a

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -23,6 +24,9 @@
 #include "io/vtk.hpp"
 #include "polygon/output.hpp"
 #include "run/flow.hpp"
+#include "run/run_dir.hpp"
+#include "run/schedule.hpp"
+#include "run/stop.hpp"
 #include "run/walls_output.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
@@ -75,6 +79,7 @@ public:
     virtual void synchronise() {}
     /// Time resolution of the engine: the loop treats times closer than this as equal [s].
     virtual double timeTolerance() const = 0;
+    virtual double dt() const = 0;             ///< time step [s] (0 for a pure event-driven run)
     virtual std::uint64_t steps() const = 0;   ///< time steps taken (0 for a pure event-driven run)
     virtual std::size_t contacts() const = 0;  ///< enduring contacts now
     virtual double maxOverlapRatio() const = 0;
@@ -97,6 +102,7 @@ public:
     const char* method() const override { return "tdm"; }
     void advanceTo(double t) override { eng_.advanceTo(t); }
     double timeTolerance() const override { return 0.5 * eng_.settings().dt; }
+    double dt() const override { return eng_.settings().dt; }
     std::uint64_t steps() const override { return eng_.steps(); }
     std::size_t contacts() const override { return eng_.forceStats().contacts; }
     double maxOverlapRatio() const override { return eng_.forceStats().maxOverlapRatio; }
@@ -135,12 +141,10 @@ class EdmDriver final : public Driver<D> {
 public:
     EdmDriver(World<D>& w, const EdmSettings& s) : w_(w), eng_(w, s) {}
     const char* method() const override { return "edm"; }
-    void advanceTo(double t) override {
-        eng_.advanceEvents(t);
-        w_.time = t;
-    }
+    void advanceTo(double t) override { w_.time = eng_.advanceEvents(t); }  // earlier than t after a stop
     void synchronise() override { eng_.synchronise(w_.time); }
     double timeTolerance() const override { return 1e-12; }
+    double dt() const override { return 0; }
     std::uint64_t steps() const override { return 0; }
     std::size_t contacts() const override { return 0; }
     double maxOverlapRatio() const override { return 0; }
@@ -184,6 +188,7 @@ public:
     void advanceTo(double t) override { eng_.advanceTo(t); }
     void synchronise() override { eng_.synchronise(); }
     double timeTolerance() const override { return 0.5 * eng_.dt(); }
+    double dt() const override { return eng_.dt(); }
     std::uint64_t steps() const override { return eng_.steps(); }
     std::size_t contacts() const override { return eng_.tdm().forceStats().contacts; }
     double maxOverlapRatio() const override { return eng_.tdm().forceStats().maxOverlapRatio; }
@@ -242,19 +247,20 @@ private:
 };
 
 template <int D>
-std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
+std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world, const std::atomic<bool>* stop) {
     switch (sc.method) {
         case Method::Tdm: {
             std::string note;
-            const TdmSettings ts = tdmSettings<D>(sc, world, &note);
+            TdmSettings ts = tdmSettings<D>(sc, world, &note);
+            ts.stop = stop;
             return std::make_unique<TdmDriver<D>>(world, ts, note);
         }
         case Method::Edm: {
             world.particles.dropTdmState();  // forces and torques: nothing reads them in this run
             EdmSettings es = edmSettings(sc);
-            es.holdState = true;
-            es.radiusBound =
-                inletRadiusBound(sc);  // positions, velocities and radii only in the engine between synchronisations
+            es.holdState = true;  // positions, velocities and radii only in the engine between synchronisations
+            es.radiusBound = inletRadiusBound(sc);
+            es.stop = stop;
             return std::make_unique<EdmDriver<D>>(world, es);
         }
         case Method::Haet: {
@@ -262,6 +268,7 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world) {
             const TdmSettings ts = tdmSettings<D>(sc, world, &note);
             HaetSettings hs = haetSettings<D>(sc);
             hs.radiusBound = inletRadiusBound(sc);
+            hs.stop = stop;  // the hybrid stops between its steps; its engines, inside one, do not
             return std::make_unique<HaetDriver<D>>(world, ts, edmSettings(sc), hs, note);
         }
     }
@@ -427,24 +434,23 @@ private:
 template <int D>
 RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
     const auto t0 = Clock::now();
-    std::filesystem::path dir = opt.outDir.empty() ? std::filesystem::path(sc.output.directory) : opt.outDir;
-    std::filesystem::create_directories(dir);
+    const std::filesystem::path dir = opt.outDir.empty() ? std::filesystem::path(sc.output.directory) : opt.outDir;
 
     World<D> world = buildWorld<D>(sc);
-    std::unique_ptr<Driver<D>> eng = makeDriver<D>(sc, world);
+    StopSignals signals;
+    std::unique_ptr<Driver<D>> eng = makeDriver<D>(sc, world, signals.flag());
+    const RunPlan plan = planRun(sc, eng->dt(), world.contact.contactTime);
+    for (const auto& [key, what] : plan.warnings) log << "warning: " << key << ": " << what << "\n";
 
-    const double seriesPeriod = sc.output.seriesPeriod > 0 ? sc.output.seriesPeriod : sc.duration / 100;
-    const double snapPeriod = sc.output.snapshotPeriod == 0 ? sc.duration / 20 : sc.output.snapshotPeriod;
+    prepareRunDirectory(dir);
     std::vector<std::string> columns = {
         "time",         "step",        "kinetic_energy", "rotational_energy", "potential_energy", "elastic_energy",
         "total_energy", "n_particles", "n_contacts",     "max_overlap_ratio", "pressure"};
     for (auto& c : eng->extraColumns()) columns.push_back(c);
     Flow<D> flow(sc, world, eng->stepTime());
     for (auto& c : flow.columns()) columns.push_back(c);
-    SeriesWriter series(dir / "series.csv", columns);
-    SnapshotWriter<D> snaps(dir);
     double lastRowTime = world.time;
-    auto writeRow = [&]() {
+    auto rowValues = [&](double stamp) {
         const Energies<D> e = energies(world);
         const double elastic = eng->elasticEnergy();
         const double window = world.time - lastRowTime;
@@ -452,7 +458,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         std::optional<double> pressure;
         const double vir = eng->virial(window);
         if (world.domain.fullyPeriodic()) pressure = (e.mv2 + vir) / (D * world.domain.volume());
-        std::vector<std::optional<double>> row = {world.time,
+        std::vector<std::optional<double>> row = {stamp,
                                                   double(eng->steps()),
                                                   e.kinetic,
                                                   e.rotational,
@@ -465,7 +471,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                                                   pressure};
         for (auto& v : eng->extraRow()) row.push_back(v);
         for (auto& v : flow.row(world.time)) row.push_back(v);
-        series.row(row);
+        return row;
     };
 
     auto writeRunJson = [&](const std::string& status) {
@@ -489,53 +495,92 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         j.add("steps", eng->steps());
         eng->describe(j);
         flow.describe(j);
+        if (!plan.warnings.empty()) {  // what the run warned of on stderr, by the key concerned
+            JsonObject w;
+            for (const auto& [key, what] : plan.warnings) w.add(key, what);
+            j.add("warnings", w);
+        }
         j.add("wall_time", wall);
         j.add("particle_steps_per_second", wall > 0 ? double(eng->steps()) * world.particles.size() / wall : 0.0);
         j.add("threads", static_cast<std::int64_t>(omp_get_max_threads()));
         j.add("peak_rss_bytes", peakRssBytes());
         writeFileAtomic(dir / "run.json", j.dump() + "\n");
     };
+    // A run killed before its end (kill -9, a node lost) leaves run.json saying so; it also proves the directory
+    // writable before any time is spent.
+    writeRunJson("running");
+    SeriesWriter series(dir / "series.csv", columns);
+    SnapshotWriter<D> snaps(dir);
 
-    const bool tty = !opt.quiet && isatty(STDERR_FILENO);
+    const bool tty = opt.progress == ProgressDisplay::On ||
+                     (opt.progress == ProgressDisplay::Auto && !opt.quiet && isatty(STDERR_FILENO));
     Progress progress(tty, sc.duration);
-    double nextSeries = 0, nextSnap = 0;
     const double eps = eng->timeTolerance();
-    // On a terminal the progress line updates at least every 1/500 of the run (and never less than one step), so
-    // it stays live; otherwise the engine runs from output to output in one call (a time-driven engine predicts
-    // each step in the pass of the step before, except the last step of a call).
-    const double chunk = tty ? std::max(sc.duration / 500, 2 * eps) : std::numeric_limits<double>::infinity();
+    OutputClock rows(plan.seriesPeriod), shots(plan.snapshotPeriod);
+    // The engine is called in the same pieces whether or not the progress line shows (an event-driven engine's
+    // state depends on where its calls end): up to every output time and every 1/500 of the run, at which the
+    // progress line may update (at most every 200 ms).
+    OutputClock chunks(sc.duration / 500);
+    double lastRow = -1, lastShot = -1;  // engine times of the last row and snapshot written
+    auto row = [&](double stamp) {
+        eng->synchronise();
+        series.row(rowValues(stamp));
+        lastRow = world.time;
+    };
+    auto shot = [&](double stamp) {
+        eng->synchronise();
+        snaps.write(world, stamp, eng->hybrid());
+        series.flush();
+        lastShot = world.time;
+    };
     RunStatus status = RunStatus::Completed;
     std::string statusText = "completed";
     try {
         for (;;) {
-            if (world.time + eps >= nextSeries) {
-                eng->synchronise();
-                writeRow();
-                nextSeries += seriesPeriod;
+            if (rows.due(world.time, eps)) {
+                row(OutputClock::stamp(world.time, rows.next()));
+                rows.pass(world.time, eps);
             }
-            if (snapPeriod > 0 && world.time + eps >= nextSnap) {
-                eng->synchronise();
-                snaps.write(world, world.time, eng->hybrid());
-                series.flush();
-                nextSnap += snapPeriod;
+            if (shots.due(world.time, eps)) {
+                shot(OutputClock::stamp(world.time, shots.next()));
+                shots.pass(world.time, eps);
             }
-            if (world.time + eps >= sc.duration) {
-                eng->synchronise();
-                break;
-            }
-            double target = std::min(sc.duration, nextSeries);
-            if (snapPeriod > 0) target = std::min(target, nextSnap);
-            while (world.time + eps < target) {
-                eng->advanceTo(std::min({target, world.time + chunk, flow.nextTime()}));
-                if (world.time + eps >= flow.nextTime()) flow.act(world, *eng, eps);
-                progress.update(world.time, eng->steps(), eng->contacts());
-            }
+            if (world.time + eps >= sc.duration || signals.requested()) break;
+            // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
+            const double target = std::min({sc.duration, rows.next(), shots.next(), flow.nextTime()});
+            while (chunks.due(world.time, eps)) chunks.pass(world.time, eps);
+            eng->advanceTo(chunks.next() < target - eps ? chunks.next() : target);
+            if (world.time + eps >= flow.nextTime()) flow.act(world, *eng, eps);
+            progress.update(world.time, eng->steps(), eng->contacts());
         }
     } catch (const SimulationError& e) {
         progress.finish();
         log << "error: simulation stopped: " << e.what() << "\n";
         status = RunStatus::BlewUp;
         statusText = std::string("failed: ") + e.what();
+    } catch (const IoError& e) {
+        // Disk full, directory gone: every file on disk is still a whole one (atomic writes); say so in run.json
+        // if that still can be written.
+        progress.finish();
+        try {
+            writeRunJson(std::string("failed: output: ") + e.what());
+        } catch (const IoError&) {
+        }
+        throw;
+    }
+    if (signals.requested()) {
+        status = signals.signal() == SIGINT ? RunStatus::Interrupted : RunStatus::Terminated;
+        statusText = "interrupted";
+        log << (signals.signal() == SIGINT ? "\nSIGINT" : "\nSIGTERM") << ": stopped at t = " << world.time
+            << " s; writing the last state\n";
+    }
+    // The last state, always: a row and a snapshot at the time the run ended, unless the schedule just wrote them.
+    // (A checkpoint of the whole state, for a restart, would be written here too, before run.json closes the run.)
+    try {
+        if (lastRow != world.time) row(OutputClock::stamp(world.time, sc.duration));
+        if (lastShot != world.time) shot(OutputClock::stamp(world.time, sc.duration));
+    } catch (const SimulationError& e) {  // a blown-up state the engine cannot bring to one time
+        log << "error: the last state cannot be written: " << e.what() << "\n";
     }
     progress.update(world.time, eng->steps(), eng->contacts(), true);
     progress.finish();

@@ -1,7 +1,9 @@
 #pragma once
 // Runs a scenario: builds the world, drives the engine to the requested time, and writes every output
 // (series.csv, VTK snapshots + .pvd, walls, run.json). Writers run at fixed simulated times; the engine only
-// advances. Exit codes of `haet run`: 0 done, 2 bad input, 3 the simulation blew up (outputs so far kept).
+// advances. Exit codes of `haet run` (docs/scenario.md, "Running"): 0 done, 2 bad input, 3 the simulation blew up
+// (outputs so far kept), 4 an output could not be written, 130 / 143 stopped by SIGINT / SIGTERM (the last state
+// written).
 #include <filesystem>
 #include <iosfwd>
 
@@ -9,13 +11,18 @@
 
 namespace haet {
 
+/// The progress line on stderr: Auto shows it on a terminal unless quiet. It never changes what is computed.
+enum class ProgressDisplay { Auto, On, Off };
+
 struct RunOptions {
     std::filesystem::path outDir;  ///< empty: the scenario's [output] directory
     int threads = 0;               ///< 0: OpenMP default
     bool quiet = false;            ///< no progress bar and no summary
+    ProgressDisplay progress = ProgressDisplay::Auto;
 };
 
-enum class RunStatus { Completed = 0, BadInput = 2, BlewUp = 3 };
+/// The exit code of `haet run` for each outcome.
+enum class RunStatus { Completed = 0, BadInput = 2, BlewUp = 3, OutputFailed = 4, Interrupted = 130, Terminated = 143 };
 
 RunStatus runScenario(const Scenario& sc, const RunOptions& opt, std::ostream& log);
 

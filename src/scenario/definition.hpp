@@ -62,6 +62,7 @@ struct DomainDef {
     Vec3d hi{1, 1, 1};                                  ///< upper corner [m]
     std::array<bool, 3> periodic{false, false, false};  ///< periodic per axis
     Vec3d gravity{0, 0, 0};                             ///< [m/s^2]
+    SourcePos pos;                                      ///< the [domain] table
 };
 
 /// A [materials.NAME] table: the properties the contact laws read (contact/model.hpp) and where they were set.
@@ -84,6 +85,7 @@ struct TdmDef {
     double maxOverlap = 0.5;       ///< blow-up: stop when overlap / smaller radius exceeds this [-]
     int sortEvery = 1000;          ///< spatial re-sort of particles every N steps (0 = never)
     SourcePos pos;
+    SourcePos dtPos;  ///< where dt was given (the table's line when it was not)
 };
 
 enum class EdmTangential { Walton, Constant };
@@ -96,6 +98,7 @@ struct EdmDef {
     std::optional<double> tcTime;    ///< TC time [s]; default: the soft contact duration t_c
     std::optional<double> cellSize;  ///< event grid cell edge [m]; default: the largest diameter
     SourcePos pos;
+    SourcePos cellPos;  ///< where cell_size was given
 };
 
 /// The hybrid (method = "haet"), docs/physics.md A: TDM where the local volume fraction is high, EDM where low.
@@ -217,6 +220,10 @@ struct OutputDef {
     double snapshotPeriod = 0;      ///< [s] between snapshots; 0 = 1/20 of duration; < 0 = none
     SourcePos pos;
 };
+
+/// Bounds on what a run writes (docs/scenario.md, [output]): a period that asks for more is an error.
+inline constexpr double kMaxSeriesRows = 1e7;
+inline constexpr double kMaxSnapshots = 1e5;
 
 struct Scenario {
     std::string path;  ///< scenario file

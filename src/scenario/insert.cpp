@@ -15,6 +15,7 @@
 
 #include "core/polygon_shape.hpp"
 #include "neighbor/cell_grid.hpp"
+#include "scenario/checks.hpp"
 #include "scenario/text.hpp"
 #include "scenario/walls.hpp"
 
@@ -328,6 +329,7 @@ std::vector<NewParticle<D>> insertFromFile(const Scenario& s, std::size_t k) {
     const std::string key = insertKey(k) + ".file";
     const ParticleFile pf =
         in.format == FileFormat::Csv ? readParticleCsv(in.file, D, s.materials, key) : readLammpsData(in.file, key);
+    checkFileParticles<D>(s, k, pf);  // sizes, box, overlaps of hard particles (scenario/checks.hpp)
     std::vector<NewParticle<D>> out;
     out.reserve(pf.particles.size());
     for (const FileParticle& fp : pf.particles) {

@@ -8,11 +8,13 @@
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <utility>
 #include <vector>
 
+#include "scenario/checks.hpp"
 #include "scenario/flow_loader.hpp"
 #include "scenario/table_reader.hpp"
 #include "scenario/text.hpp"
@@ -44,6 +46,7 @@ public:
         readFlows(s);
         checkDiskLaw(s);
         readOutput(s);
+        checkScenario(s);  // the checks across tables (scenario/checks.hpp)
         return s;
     }
 
@@ -80,6 +83,7 @@ private:
         const TableReader r = child("domain");
         r.allowOnly({"lo", "hi", "periodic", "gravity"});
         DomainDef& d = s.domain;
+        d.pos = r.tablePos();
         d.lo = r.requiredVector("lo", dim_);
         d.hi = r.requiredVector("hi", dim_);
         for (int k = 0; k < dim_; ++k)
@@ -118,8 +122,10 @@ private:
             if (!(m.young > 0)) r.fail("young", "must be > 0");
             m.poisson = r.number("poisson").value_or(m.poisson);
             if (!(m.poisson > -1 && m.poisson < 0.5)) r.fail("poisson", "must satisfy -1 < poisson < 0.5");
-            m.restitution = r.requiredNumber("restitution");
-            if (!(m.restitution > 0 && m.restitution <= 1)) r.fail("restitution", "must satisfy 0 < e <= 1");
+            // Optional where nothing reads it (the linear law with kn and gamma_n, checkRestitution).
+            m.restitution = r.number("restitution").value_or(kRestitutionUnset);
+            if (r.has("restitution") && !(m.restitution > 0 && m.restitution <= 1))
+                r.fail("restitution", "must satisfy 0 < e <= 1");
             m.friction = r.requiredNumber("friction");
             if (!(m.friction >= 0)) r.fail("friction", "must be >= 0");
             m.tangentialRestitution = r.number("tangential_restitution").value_or(m.tangentialRestitution);
@@ -214,12 +220,16 @@ private:
                                                 {{"verlet", IntegratorKind::Verlet}, {"gear5", IntegratorKind::Gear5}})
                            .value_or(IntegratorKind::Verlet);
         t.integratorGiven = r.has("integrator");
+        t.dtPos = r.posOf("dt");
         if (const toml::node* n = r.table().get("dt")) {
             if (const auto* str = n->as_string()) {
                 if (str->get() != "auto") r.fail("dt", "must be \"auto\" or a number > 0");
             } else if (n->is_number()) {
                 t.dt = r.number("dt");
                 if (!(*t.dt > 0)) r.fail("dt", "must be > 0");
+                if (*t.dt > s.duration)
+                    r.fail("dt", "the time step " + formatNumber(*t.dt) + " s is longer than the duration " +
+                                     formatNumber(s.duration) + " s: the run would take no step");
             } else {
                 r.fail("dt", "expected a number or \"auto\"");
             }
@@ -249,6 +259,7 @@ private:
         e.tcTime = r.number("tc_time");
         if (e.tcTime && !(*e.tcTime > 0)) r.fail("tc_time", "must be > 0");
         e.cellSize = r.number("cell_size");
+        e.cellPos = r.posOf("cell_size");
         if (e.cellSize && !(*e.cellSize > 0)) r.fail("cell_size", "must be > 0");
     }
 
@@ -500,6 +511,21 @@ private:
         o.seriesPeriod = r.number("series_period").value_or(o.seriesPeriod);
         if (!(o.seriesPeriod >= 0)) r.fail("series_period", "must be >= 0");
         o.snapshotPeriod = r.number("snapshot_period").value_or(o.snapshotPeriod);
+        checkOutputCounts(r, s);
+    }
+
+    /// A period that would write more rows or snapshots than a run can keep (series.csv is held in memory and
+    /// rewritten whole, so that it is always complete on disk) is an error, not hours of output at t = 0.
+    void checkOutputCounts(const TableReader& r, const Scenario& s) const {
+        const OutputDef& o = s.output;
+        if (o.seriesPeriod > 0 && s.duration / o.seriesPeriod > kMaxSeriesRows)
+            r.fail("series_period", formatNumber(o.seriesPeriod) + " s asks for " +
+                                        formatNumber(std::floor(s.duration / o.seriesPeriod)) + " rows over " +
+                                        formatNumber(s.duration) + " s; at most " + formatNumber(kMaxSeriesRows));
+        if (o.snapshotPeriod > 0 && s.duration / o.snapshotPeriod > kMaxSnapshots)
+            r.fail("snapshot_period", formatNumber(o.snapshotPeriod) + " s asks for " +
+                                          formatNumber(std::floor(s.duration / o.snapshotPeriod)) + " snapshots over " +
+                                          formatNumber(s.duration) + " s; at most " + formatNumber(kMaxSnapshots));
     }
 
     TableReader root_;
@@ -657,10 +683,7 @@ Scenario parseScenario(std::string_view text, const std::filesystem::path& file,
 }
 
 Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw ScenarioError({file.string(), 0}, "", "cannot open the scenario file");
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    return parseScenario(text, file, overrides);
+    return parseScenario(readScenarioText(file), file, overrides);
 }
 
 }  // namespace haet

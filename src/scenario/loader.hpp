@@ -25,6 +25,11 @@ Scenario loadScenario(const std::filesystem::path& file, const std::vector<std::
 Scenario parseScenario(std::string_view text, const std::filesystem::path& file,
                        const std::vector<std::string>& overrides = {});
 
+/// The text of a scenario file, read to at most kMaxScenarioBytes. Throws ScenarioError for a directory, a file that
+/// cannot be read, a longer one (a device such as /dev/zero) or one that holds NUL bytes.
+inline constexpr std::size_t kMaxScenarioBytes = std::size_t(16) << 20;
+std::string readScenarioText(const std::filesystem::path& file);
+
 /// FNV-1a 64-bit hash of `bytes` as 16 lower-case hex digits (Scenario::hash).
 std::string fnv1a64Hex(std::string_view bytes);
 

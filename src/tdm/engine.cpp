@@ -7,7 +7,7 @@
 namespace haet {
 
 template <int D>
-TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s) {
+TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s), t0_(world.time) {
     if (!w_.particles.hasTdmState())
         throw std::invalid_argument("time-driven engine: the particle store has dropped forces and torques");
     if constexpr (D == 2)
@@ -283,10 +283,14 @@ void TdmEngine<D>::step() {
 
 template <int D>
 void TdmEngine<D>::finishStep(bool moved, std::atomic<bool>* nextMoved) {
-    w_.time += s_.dt;
+    // The k-th step ends at t0 + k dt exactly: outputs at k x period and moving walls see no drift of summed dt.
     ++steps_;
+    w_.time = timeAfter(0);
     moveWalls();
-    if (moved) rebuild(s_.sortEvery > 0 && steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery));
+    if (moved) {
+        rebuild(s_.sortEvery > 0 && steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery));
+        checkSpeeds();  // O(N) beside the O(N) rebuild; a system that blows up rebuilds at every step
+    }
     computeForces(true, nextMoved);
     checkHealth();
 }
@@ -300,11 +304,15 @@ void TdmEngine<D>::advanceTo(double t) {
     bool predicted = false, moved = false;
     while (w_.time + 0.5 * s_.dt <= t) {
         if (!predicted) moved = integ_->predict(w_.particles, s_.dt, motion_, xAtBuild_.data(), driftLimit2());
-        // After this step, whether another one follows in this call.
-        predicted = fuse && w_.time + s_.dt + 0.5 * s_.dt <= t;
+        // After this step, whether another one follows in this call; a stop asked for ends the call after it, so
+        // the state is never left holding the next step's prediction.
+        const bool stop = s_.stop && s_.stop->load(std::memory_order_relaxed);
+        const bool more = !stop && timeAfter(1) + 0.5 * s_.dt <= t;
+        predicted = fuse && more;
         std::atomic<bool> nextMoved{false};
         finishStep(moved, predicted ? &nextMoved : nullptr);
         moved = nextMoved.load(std::memory_order_relaxed);
+        if (stop) break;
     }
 }
 
@@ -324,6 +332,25 @@ void TdmEngine<D>::checkHealth() const {
         fail(stats_.worstParticle, os.str());
     }
     if (stats_.nonFinite != ForceStats::kNone) fail(stats_.nonFinite, "non-finite position or force");
+}
+
+// A particle that moves more than its radius in one step passes through contacts the steps never see: either dt is
+// far too long for its speed or the system blew up without ever holding an overlap at the end of a step (a stiff
+// spring over a step of several contact durations turns a touch into a kick).
+template <int D>
+void TdmEngine<D>::checkSpeeds() const {
+    const Particles<D>& p = w_.particles;
+    for (std::size_t i = 0; i < p.tdmCount(); ++i) {
+        const double step = norm(p.v[i]) * s_.dt;
+        if (!(step <= p.radius[i]) && !p.frozen(i)) {
+            std::ostringstream os;
+            os << "particle id " << p.id[i] << " moves " << step << " m in one step, more than its radius "
+               << p.radius[i] << " m (speed " << norm(p.v[i]) << " m/s, t = " << w_.time << " s, step " << steps_
+               << "): the system blew up, or the time step (dt = " << s_.dt << " s; contact duration "
+               << w_.contact.contactTime << " s) is too large for this speed";
+            throw SimulationError(os.str());
+        }
+    }
 }
 
 template <int D>

@@ -24,6 +24,8 @@ struct TdmSettings {
     double maxOverlap = 0.5;  ///< blow-up limit: overlap / smaller radius [-]
     int sortEvery = 1000;     ///< spatial re-sort period in steps (0 = never)
     bool planeLoads = false;  ///< keep each plane contact's force, for the planes' loads (planeLoad)
+    /// Set from outside (a signal handler: run/stop.hpp) to end advanceTo after the step under way; null: never.
+    const std::atomic<bool>* stop = nullptr;
 };
 
 template <int D>
@@ -36,8 +38,10 @@ public:
     void step();
     /// Steps until the time reaches t (to within half a step): the same state as step() repeated, bit for bit.
     /// If a step fails its health check (SimulationError) inside this call, the particles may already hold the
-    /// prediction for the step after it.
+    /// prediction for the step after it. Returns early, at the end of a whole step, once *settings().stop is set.
     void advanceTo(double t);
+    /// The time after k more steps [s]: start time + (steps + k) dt, computed as such (no sum of dt that drifts).
+    double timeAfter(std::uint64_t k) const { return t0_ + static_cast<double>(steps_ + k) * s_.dt; }
 
     const TdmSettings& settings() const { return s_; }
     std::uint64_t steps() const { return steps_; }
@@ -88,6 +92,8 @@ private:
     /// particle from[k] (kFresh: none; from null: the same particle).
     void buildCandidates(const std::uint32_t* from);
     void checkHealth() const;
+    /// Throws SimulationError when a particle moves more than its radius in one step.
+    void checkSpeeds() const;
     /// The state a force pass reads and writes (sv, sw: the step's mean velocities).
     ForceContext<D> context(const Vec<D>* sv, const Ang<D>* sw) const;
 
@@ -105,6 +111,7 @@ private:
     ForceStats stats_;
     std::unique_ptr<ShapePass> shapes_;  ///< 2D scenes with polygons: their force pass
     std::uint64_t steps_ = 0, rebuilds_ = 0, lastSort_ = 0;
+    double t0_ = 0;  ///< world.time at construction [s]
 };
 
 }  // namespace haet

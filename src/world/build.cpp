@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/rng.hpp"
+#include "scenario/checks.hpp"
 #include "scenario/insert.hpp"
 #include "scenario/walls.hpp"
 
@@ -67,10 +68,44 @@ void inletStats(const Scenario& sc, std::vector<MaterialStats>& stats) {
     }
 }
 
+/// The materials a run can bring into contact: those of its particles, its walls and its inserts (a source of
+/// particles that adds them later must list its material here too). Only their pairs are calibrated.
+static std::vector<bool> usedMaterials(const Scenario& sc, const std::vector<MaterialStats>& stats) {
+    std::vector<bool> used(sc.materials.size(), false);
+    for (std::size_t m = 0; m < stats.size() && m < used.size(); ++m) used[m] = stats[m].count > 0;
+    for (const WallDef& w : sc.walls) used[w.material] = true;
+    for (const InsertDef& in : sc.inserts) used[in.material] = true;
+    for (const InletDef& in : sc.inlets) used[in.particles.material] = true;
+    return used;
+}
+
+/// A reference head-on collision that does not end, or overlaps by more than the effective radius, means a contact
+/// law the scene's speeds break (Hertz with a tiny Young's modulus at impact_velocity): bad input, named.
+static void checkHeadOn(const Scenario& sc, const ContactSetup& cs) {
+    const ContactSetup::WorstHeadOn& w = cs.worstHeadOn;
+    if (w.a < 0 || w.overlapRatio <= 1) return;
+    const bool hertz = sc.contact.normal == NormalLaw::Hertz;
+    if (!hertz && std::isfinite(w.overlapRatio)) return;  // the linear law's t_c is the user's; its e still holds
+    const MaterialDef& m = sc.materials[w.a];
+    std::ostringstream os;
+    os << "a head-on collision of " << m.name << " with " << sc.materials[w.b].name << " at impact_velocity "
+       << sc.contact.impactVelocity << " m/s ";
+    if (std::isfinite(w.overlapRatio))
+        os << "overlaps by " << w.overlapRatio << " effective radii: the modulus is too small for contacts at this "
+           << "speed (Hertz needs overlaps well below the radius, docs/physics.md B.3)";
+    else
+        os << "does not end or is not finite: the contact law cannot be calibrated (docs/physics.md B.3)";
+    throw ScenarioError(hertz ? m.pos : sc.contact.pos,
+                        hertz ? "materials." + m.name + ".young" : std::string("contact"), os.str());
+}
+
 template <int D>
 ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialStats>& stats) {
     const std::vector<MaterialProps> props(sc.materials.begin(), sc.materials.end());
-    return buildContactSetup<D>(static_cast<const ContactModelDef&>(sc.contact), props, stats);
+    ContactSetup cs =
+        buildContactSetup<D>(static_cast<const ContactModelDef&>(sc.contact), props, stats, usedMaterials(sc, stats));
+    checkHeadOn(sc, cs);
+    return cs;
 }
 
 template <int D>
@@ -91,10 +126,37 @@ World<D> buildWorld(const Scenario& sc) {
         }
     }
     insertParticles<D>(sc, w.particles, Rng(sc.seed, RngStream::Insert));
+    checkParticles<D>(sc, w.particles);  // what the engines cannot run, with the key (scenario/checks.hpp)
     std::vector<MaterialStats> stats = materialStats(w.particles, static_cast<int>(sc.materials.size()));
     inletStats<D>(sc, stats);
     w.contact = buildContactSetup<D>(sc, stats);
     return w;
+}
+
+/// The time step against the contact duration and the run's length: a hand-set dt beyond t_c leaves every contact
+/// unresolved (velocity Verlet is unstable from dt = 2 t_c / pi on, docs/physics.md F.2) and makes the kick that
+/// blows a system up; a step longer than the run takes no step at all.
+static void checkTimeStep(const Scenario& sc, double dt, double contactTime, bool polygons) {
+    auto fmtNum = [](double v) {
+        std::ostringstream os;
+        os << v;
+        return os.str();
+    };
+    if (!(dt > 0 && dt < 1e300))  // a contact duration that overflowed (a radius of 1e300 m from a file)
+        throw ScenarioError(sc.tdm.dtPos, "tdm.dt",
+                            "the time step " + fmtNum(dt) + " s is not a usable number (check the particle sizes)");
+    if (sc.tdm.dt && !polygons && contactTime > 0 && dt > contactTime)
+        throw ScenarioError(sc.tdm.dtPos, "tdm.dt",
+                            "the time step " + fmtNum(dt) +
+                                " s is longer than the contact duration t_c = " + fmtNum(contactTime) +
+                                " s: contacts are not resolved and a touch becomes a kick "
+                                "(give dt <= t_c / 10, or dt = \"auto\")");
+    if (dt > sc.duration)
+        throw ScenarioError(sc.tdm.dtPos, sc.tdm.dt ? "tdm.dt" : "tdm.steps_per_contact",
+                            "the time step " + fmtNum(dt) + " s (" +
+                                (sc.tdm.dt ? "given" : "auto: t_c / " + fmtNum(sc.tdm.stepsPerContact)) +
+                                ") is longer than the duration " + fmtNum(sc.duration) +
+                                " s: the run would take no step");
 }
 
 template <int D>
@@ -130,6 +192,7 @@ TdmSettings tdmSettings(const Scenario& sc, const World<D>& w, std::string* dtNo
         note << "auto: t_c / " << sc.tdm.stepsPerContact << " (" << w.contact.contactTimeNote << ")";
     }
     if (dtNote) *dtNote = note.str();
+    checkTimeStep(sc, s.dt, w.contact.contactTime, polygons > 0);
     double dmax = 0;
     for (double r : w.particles.radius) dmax = std::max(dmax, 2 * r);
     for (const InletDef& in : sc.inlets) dmax = std::max(dmax, 2 * in.particles.radiusMax);  // particles to come
