@@ -75,8 +75,13 @@ public:
     std::size_t memoryBytes() const;
 
 private:
-    /// The first contact of a centre at y (box frame), velocity v, radius a with element e, after the time of y [s].
-    MeshContact<D> predictFrom(const Vec<D>& y, const Vec<D>& v, const Vec<D>& g, double a, std::uint32_t e) const;
+    /// The first contact of a centre at y (box frame), velocity v, radius a with element e, after the time of y and
+    /// no later than `cap` after it [s].
+    MeshContact<D> predictFrom(const Vec<D>& y, const Vec<D>& v, const Vec<D>& g, double a, std::uint32_t e,
+                               double cap = kNever) const;
+    /// Where slot s's search starts: its stored state in its box frame (y, v), or where that state's path enters the
+    /// box after a periodic crossing; returns the time [s].
+    static double start(const Sl& sl, std::uint32_t s, Vec<D>& y, Vec<D>& v);
     static Vec<D> boxFrame(const Sl& sl, std::uint32_t s, const Vec<D>& x);
 
     std::vector<Element> elem_;
