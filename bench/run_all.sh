@@ -7,12 +7,15 @@
 # 2. bench/compare_lammps.sh BUILD_DIR 2d   the same in 2D (8 000 disks)
 # 3. bench/haet_compare.sh BUILD_DIR        the hybrid against pure TDM and EDM (demo), dilute-fraction sweep
 # 4. bench/dilute_compare.sh BUILD_DIR      EDM against TDM on a dilute granular gas, 3D and 2D
-# 5. BUILD_DIR/haet_bench                   Google Benchmark micro-benchmarks, when built
-# 6. BUILD_DIR/haet_bench PolygonSettle2D   10 000 hexagons vs 10 000 disks settling, 1 and 2 threads, side by
+# 5. bench/compare_liggghts.sh BUILD_DIR    HAET against LIGGGHTS, the 3D silo of two STL meshes (6 000 spheres)
+# 6. bench/mesh_floor.sh BUILD_DIR          a settled bed on a 10 082-triangle mesh floor against its plane (wall time;
+#                                           instruction counts too when BUILD_DIR-v3, an x86-64-v3 build, exists)
+# 7. BUILD_DIR/haet_bench                   Google Benchmark micro-benchmarks, when built
+# 8. BUILD_DIR/haet_bench PolygonSettle2D   10 000 hexagons vs 10 000 disks settling, 1 and 2 threads, side by
 #                                           side in one run, with the polygon/disk cost ratio
 # The first run on a machine prepares the flowing states with LAMMPS (10-15 min for 3D, once; kept in
-# bench/data/). Installs the Debian packages lammps and time when missing. Exits non-zero when any part failed,
-# after running the others.
+# bench/data/) and LIGGGHTS (a few minutes), and the settled bed (about a minute). Installs the Debian packages
+# lammps, liggghts and time when missing. Exits non-zero when any part failed, after running the others.
 set -uo pipefail
 
 [ $# -eq 1 ] || { echo "usage: $0 BUILD_DIR" >&2; exit 2; }
@@ -22,6 +25,7 @@ here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 
 missing=""
 command -v "${LMP:-lmp}" >/dev/null || missing="$missing lammps"
+command -v "${LIGGGHTS:-liggghts}" >/dev/null || missing="$missing liggghts"
 [ -x /usr/bin/time ] || missing="$missing time"
 if [ -n "$missing" ]; then
     echo "installing:$missing"
@@ -43,6 +47,14 @@ echo
 
 echo "=== dilute gas: EDM vs TDM"
 "$here/dilute_compare.sh" "$build" || failed="$failed dilute"
+echo
+
+echo "=== silo: HAET vs LIGGGHTS"
+"$here/compare_liggghts.sh" "$build" || failed="$failed silo"
+echo
+
+echo "=== mesh floor vs plane floor"
+"$here/mesh_floor.sh" "$build" || failed="$failed mesh_floor"
 echo
 
 if [ -x "$build/haet_bench" ]; then

@@ -20,7 +20,8 @@ TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s
         integ_ = std::move(vv);
     }
     wallHistory_.assign(w_.particles.tdmCount() * w_.walls.size(), Vec<D>::zero());
-    surf_.walls = &w_.surfaces;
+    surf_.setWalls(&w_.surfaces);
+    for (const SurfaceWall<D>& wall : w_.surfaces) staticSurfaces_ = staticSurfaces_ && !wall.motion.moves();
     if (s_.planeLoads) planeForce_.assign(w_.particles.tdmCount() * w_.walls.size(), Vec<D>::zero());
     moveWalls();
     rebuild(s_.sortEvery > 0);
@@ -125,7 +126,12 @@ void TdmEngine<D>::rebuild(bool sort) {
     pairs_ = std::move(fresh);
     xAtBuild_.assign(p.x.begin(), p.x.begin() + static_cast<std::ptrdiff_t>(n));
     ++rebuilds_;
-    if (!surf_.empty()) buildCandidates(sortOrder.empty() ? nullptr : sortOrder.data());
+    // Until the next build no particle moves more than skin/2 from here; a moving wall may close in by the other
+    // half (moveWalls), so only a scene whose walls of any shape all stand still can do with candidates within
+    // the radius plus half the skin (docs/physics.md H.4; a hair more, for the rounding of the drift test).
+    if (!surf_.empty())
+        buildCandidates(sortOrder.empty() ? nullptr : sortOrder.data(),
+                        staticSurfaces_ ? 0.5 * (1 + 1e-9) * s_.skin : s_.skin);
 }
 
 template <int D>
@@ -144,14 +150,14 @@ void TdmEngine<D>::moveWalls() {
             m.maxDisplacement(surf_.candidatesTime, w_.time, walls[q].reachFrom(m.centre)) > 0.5 * s_.skin)
             far = true;
     }
-    if (far && surf_.slotOf.size() == w_.particles.tdmCount()) buildCandidates(nullptr);
+    if (far && surf_.slotOf.size() == w_.particles.tdmCount()) buildCandidates(nullptr, s_.skin);
 }
 
 template <int D>
-void TdmEngine<D>::buildCandidates(const std::uint32_t* from) {
+void TdmEngine<D>::buildCandidates(const std::uint32_t* from, double margin) {
     const Particles<D>& p = w_.particles;
     const std::size_t n = p.tdmCount();
-    buildSurfaceCandidates(p, n, w_.domain, w_.surfaces, surf_.poses, s_.skin, surf_.candidates);
+    buildSurfaceCandidates(p, n, w_.domain, w_.surfaces, surf_.poses, margin, surf_.candidates);
     surf_.candidatesTime = w_.time;
     std::vector<std::uint32_t> slotOf(n, SurfaceState<D>::kNoSlots);
     std::vector<std::uint8_t> count(n, 0);
@@ -250,7 +256,7 @@ void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
     xAtBuild_.swap(xb);
     remapPairList(p, w_.domain, NeighborSettings{s_.skin, true}, from, pairs_, xAtBuild_.data());
     if (s_.planeLoads) planeForce_.assign(n * nw, Vec<D>::zero());
-    if (!surf_.empty()) buildCandidates(from.data());
+    if (!surf_.empty()) buildCandidates(from.data(), s_.skin);  // kept particles drifted from xAtBuild_ already
 }
 
 template <int D>

@@ -76,6 +76,8 @@ public:
     WallLoad surfaceLoad(std::size_t w) const;
     /// The walls' contacts with particles now (planes and walls of any shape) [-].
     std::size_t wallContacts() const;
+    /// The walls of any shape as the last force pass saw them: poses, candidates, contacts (for tests).
+    const SurfaceState<D>& surfaceState() const { return surf_; }
 
 private:
     /// Forces at the current (predicted) state; with correct, also the integrator's corrector; with nextMoved
@@ -88,9 +90,10 @@ private:
     void rebuild(bool sort);
     /// Planes and walls of any shape to the current time; the candidates rebuilt if a wall moved too far.
     void moveWalls();
-    /// The broad phase of walls of any shape at the current poses; the contacts of new particle k are those of old
-    /// particle from[k] (kFresh: none; from null: the same particle).
-    void buildCandidates(const std::uint32_t* from);
+    /// The broad phase of walls of any shape at the current poses, the elements within each particle's radius plus
+    /// margin [m]; the contacts of new particle k are those of old particle from[k] (kFresh: none; from null: the
+    /// same particle).
+    void buildCandidates(const std::uint32_t* from, double margin);
     void checkHealth() const;
     /// Throws SimulationError when a particle moves more than its radius in one step.
     void checkSpeeds() const;
@@ -107,6 +110,7 @@ private:
     std::vector<Vec<D>> wallHistory_;
     std::vector<Vec<D>> planeForce_;  ///< with planeLoads: each (particle, plane) contact's force [N]
     SurfaceState<D> surf_;
+    bool staticSurfaces_ = true;  ///< no wall of any shape moves: candidates with the pair list reach skin/2 (rebuild)
     std::vector<Vec<D>> xAtBuild_;
     ForceStats stats_;
     std::unique_ptr<ShapePass> shapes_;  ///< 2D scenes with polygons: their force pass

@@ -61,15 +61,30 @@ public:
         std::uint32_t hitWall[kMaxHits];
         int nh = 0;
         const std::uint32_t k1 = s.candidates.first[i + 1];
+        // Beyond this squared distance from its box an element cannot touch (the boxes are widened for rounding,
+        // surface_state.hpp, and so is this bound).
+        const double beyond2 = ri * ri * (1 + 1e-9);
         for (std::uint32_t k = s.candidates.first[i]; k < k1;) {
             // One wall's candidates at a time: its contacts are merged among themselves.
             const std::uint32_t w = s.candidates.wall[k];
             const Vec<D> xb = s.poses[w].toBody(xi);
             const int start = nh;
-            for (; k < k1 && s.candidates.wall[k] == w; ++k)
-                walls[w].contacts(s.candidates.element[k], xb, ri, [&](const SurfaceHit<D>& h) {
-                    if (nh < kMaxHits) hits[nh++] = h;
-                });
+            auto emit = [&](const SurfaceHit<D>& h) {
+                if (nh < kMaxHits) hits[nh++] = h;
+            };
+            if (walls[w].kind == SurfaceKind::Mesh) {
+                // On a fine mesh a particle has many candidates and touches one or two: the distance to an
+                // element's box, a few instructions, rules out most before their closest points are found.
+                const ElementBox<D>* box = s.boxes.data() + s.boxFirst[w];
+                for (; k < k1 && s.candidates.wall[k] == w; ++k) {
+                    const std::uint32_t e = s.candidates.element[k];
+                    if (boxDistance2(box[e], xb) > beyond2) continue;
+                    walls[w].contacts(e, xb, ri, emit);
+                }
+            } else {
+                for (; k < k1 && s.candidates.wall[k] == w; ++k)
+                    walls[w].contacts(s.candidates.element[k], xb, ri, emit);
+            }
             nh = start + mergeHits(hits.v + start, nh - start);
             for (int q = start; q < nh; ++q) hitWall[q] = w;
         }
@@ -144,6 +159,16 @@ public:
     }
 
 private:
+    /// The squared distance from x to box b (0 inside it) [m^2].
+    static double boxDistance2(const ElementBox<D>& b, const Vec<D>& x) {
+        double d2 = 0;
+        for (int a = 0; a < D; ++a) {
+            const double d = std::max(b.lo[a] - x[a], 0.0) + std::max(x[a] - b.hi[a], 0.0);
+            d2 += d * d;
+        }
+        return d2;
+    }
+
     SurfaceState<D>* s_;
     const Vec<D>* x_;
     const Vec<D>* v_;

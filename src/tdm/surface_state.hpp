@@ -6,6 +6,8 @@
 // within 60 degrees), so its tangential spring survives the step from one triangle or segment to the next
 // (docs/physics.md H.3). Only particles with candidates hold slots, so a scene's memory grows with the particles
 // near its walls, not with all of them.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -27,6 +29,12 @@ struct SurfaceContact {
     std::uint32_t wall = 0;  ///< index into the surface walls
 };
 
+/// An element's box in its wall's body frame [m].
+template <int D>
+struct ElementBox {
+    Vec<D> lo, hi;
+};
+
 template <int D>
 struct SurfaceState {
     static constexpr std::uint32_t kNoSlots = 0xFFFFFFFFu;
@@ -38,8 +46,35 @@ struct SurfaceState {
     std::vector<std::uint32_t> slotOf;
     std::vector<std::uint8_t> count;
     std::vector<SurfaceContact<D>> slots;
+    /// The body-frame boxes of the mesh walls' elements, wall w's at boxes[boxFirst[w] + e] (none for other shapes):
+    /// the force pass skips a candidate whose box lies beyond the particle's radius before finding its closest
+    /// point. Each box is widened by 1e-9 of its size and distance from the origin, so that a closest point as
+    /// computed, rounded, never lies outside it: a skipped element could not have touched.
+    std::vector<std::uint32_t> boxFirst;
+    std::vector<ElementBox<D>> boxes;
 
     bool empty() const { return walls == nullptr || walls->empty(); }
+
+    /// Sets the walls and makes their elements' boxes (their shapes never change in the body frame).
+    void setWalls(const std::vector<SurfaceWall<D>>* w) {
+        walls = w;
+        boxFirst.assign(1, 0);
+        boxes.clear();
+        for (const SurfaceWall<D>& wall : *w) {
+            if (wall.kind == SurfaceKind::Mesh)
+                for (std::size_t e = 0; e < wall.elementCount(); ++e) {
+                    ElementBox<D> b;
+                    wall.bounds(e, b.lo, b.hi);
+                    double size = 0;
+                    for (int a = 0; a < D; ++a)
+                        size = std::max({size, b.hi[a] - b.lo[a], std::abs(b.lo[a]), std::abs(b.hi[a])});
+                    b.lo -= Vec<D>::filled(1e-9 * size);
+                    b.hi += Vec<D>::filled(1e-9 * size);
+                    boxes.push_back(b);
+                }
+            boxFirst.push_back(static_cast<std::uint32_t>(boxes.size()));
+        }
+    }
 };
 
 }  // namespace haet
