@@ -136,6 +136,33 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     notify(t, a, b, false, elastic, hop, P);
 }
 
+// A particle's collision with an infinitely heavy partner at rest or in motion (b2: a plane, a mesh element), once
+// it is known to approach: the particle brought to t, the impulse along n by the law of materials (ma, wallMaterial)
+// or elastic by the TC model (with the rest hop), the books.
+template <int D>
+typename EdmEngine<D>::WallHit EdmEngine<D>::wallImpulse(std::uint32_t s, double t, CollisionBody<D>& b1,
+                                                         CollisionBody<D>& b2, const Vec<D>& n, double gn, double uRest,
+                                                         int ma, int wallMaterial, bool smooth) {
+    Particles<D>& p = w_.particles;
+    const std::uint32_t i = sl_.rec[s].idx;
+    WallHit h;
+    sl_.advance(s, t);
+    h.elastic = tc_.elastic(s, kNil, t);
+    h.P = impulseWithHop(b1, b2, n, lawFor(ma, wallMaterial, h.elastic), gn < 0, gn, uRest, h.hop);
+    const double before = kineticEnergy(b1);
+    applyImpulse(b1, b2, n, h.P);
+    stats_.dissipated += before - kineticEnergy(b1);
+    if (h.elastic && observer_) observer_->tcCollision(i);
+    sl_.hot[s].v = b1.v;
+    if (!smooth) p.w[i] = b1.w;
+    ++sl_.link[s].count;
+    tc_.collided(s, t);
+    ++stats_.wallCollisions;
+    if (h.elastic) ++stats_.tcElastic;
+    if (h.hop) ++stats_.restHops;
+    return h;
+}
+
 template <int D>
 void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
     Particles<D>& p = w_.particles;
@@ -155,22 +182,8 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
         ++stats_.grazing;
         return;
     }
-    sl_.advance(s, t);
-    const bool elastic = tc_.elastic(s, kNil, t);
-    bool hop = false;
-    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(ma, wl.material, elastic), gn < 0, gn, uRest, hop);
-    const double before = kineticEnergy(b1);
-    applyImpulse(b1, b2, n, P);
-    stats_.dissipated += before - kineticEnergy(b1);
-    if (elastic && observer_) observer_->tcCollision(i);
-    sl_.hot[s].v = b1.v;
-    if (!smooth) p.w[i] = b1.w;
-    ++sl_.link[s].count;
-    tc_.collided(s, t);
-    ++stats_.wallCollisions;
-    if (elastic) ++stats_.tcElastic;
-    if (hop) ++stats_.restHops;
-    notify(t, s, w, true, elastic, hop, P);
+    const WallHit h = wallImpulse(s, t, b1, b2, n, gn, uRest, ma, wl.material, smooth);
+    notify(t, s, w, true, h.elastic, h.hop, h.P);
 }
 
 // A mesh element as a plane wall at rest whose normal is the contact's (predict_mesh.hpp: from the contact point to the
@@ -201,32 +214,20 @@ void EdmEngine<D>::collideMesh(std::uint32_t s, std::uint32_t e, double t) {
         ++stats_.grazing;
         return;
     }
-    sl_.advance(s, t);
-    const bool elastic = tc_.elastic(s, kNil, t);
-    bool hop = false;
-    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(ma, wallMaterial, elastic), gn < 0, gn, uRest, hop);
-    const double before = kineticEnergy(b1);
-    applyImpulse(b1, b2, n, P);
-    stats_.dissipated += before - kineticEnergy(b1);
-    if (elastic && observer_) observer_->tcCollision(i);
-    sl_.hot[s].v = b1.v;
-    if (!smooth) p.w[i] = b1.w;
-    ++sl_.link[s].count;
-    tc_.collided(s, t);
-    ++stats_.wallCollisions;
-    if (elastic) ++stats_.tcElastic;
-    if (hop) ++stats_.restHops;
-    notify(t, s, mesh_.wall(e), true, elastic, hop, P, mesh_.local(e));
+    const WallHit h = wallImpulse(s, t, b1, b2, n, gn, uRest, ma, wallMaterial, smooth);
+    notify(t, s, mesh_.wall(e), true, h.elastic, h.hop, h.P, mesh_.local(e));
 }
 
 // The members defined here, for both dimensions (the class itself is instantiated in edm/engine.cpp).
-#define HAET_EDM_COLLIDE(D)                                                                                   \
-    template CollisionLaw EdmEngine<D>::lawFor(int, int, bool) const;                                         \
-    template bool EdmEngine<D>::smoothPair(int, int) const;                                                   \
-    template void EdmEngine<D>::notify(double, std::uint32_t, std::uint32_t, bool, bool, bool, const Vec<D>&, \
-                                       std::uint32_t);                                                        \
-    template void EdmEngine<D>::collidePair(std::uint32_t, std::uint32_t, double);                            \
-    template void EdmEngine<D>::collideWall(std::uint32_t, std::uint32_t, double);                            \
+#define HAET_EDM_COLLIDE(D)                                                                                          \
+    template CollisionLaw EdmEngine<D>::lawFor(int, int, bool) const;                                                \
+    template bool EdmEngine<D>::smoothPair(int, int) const;                                                          \
+    template void EdmEngine<D>::notify(double, std::uint32_t, std::uint32_t, bool, bool, bool, const Vec<D>&,        \
+                                       std::uint32_t);                                                               \
+    template void EdmEngine<D>::collidePair(std::uint32_t, std::uint32_t, double);                                   \
+    template void EdmEngine<D>::collideWall(std::uint32_t, std::uint32_t, double);                                   \
+    template EdmEngine<D>::WallHit EdmEngine<D>::wallImpulse(                                                        \
+        std::uint32_t, double, CollisionBody<D>&, CollisionBody<D>&, const Vec<D>&, double, double, int, int, bool); \
     template void EdmEngine<D>::collideMesh(std::uint32_t, std::uint32_t, double);
 HAET_EDM_COLLIDE(2)
 HAET_EDM_COLLIDE(3)

@@ -220,6 +220,15 @@ private:
     void advanceReference(double t);
     void collidePair(std::uint32_t a, std::uint32_t b, double t);
     void collideWall(std::uint32_t s, std::uint32_t w, double t);
+    /// What a collision with a wall or a mesh element did (wallImpulse): the impulse on the particle, and whether the
+    /// TC model made it elastic and the rest hop lifted it.
+    struct WallHit {
+        Vec<D> P;
+        bool elastic = false;
+        bool hop = false;
+    };
+    WallHit wallImpulse(std::uint32_t s, double t, CollisionBody<D>& b1, CollisionBody<D>& b2, const Vec<D>& n,
+                        double gn, double uRest, int ma, int wallMaterial, bool smooth);
     /// Slot s against mesh element e (edm/mesh_walls.hpp) at time t, with the normal of the predicted contact.
     void collideMesh(std::uint32_t s, std::uint32_t e, double t);
     /// The best so far (best) against the mesh elements binned into slot s's cell, at time now.
