@@ -147,7 +147,7 @@ void TdmEngine<D>::moveWalls() {
         // Particles move up to skin/2 before the pair list (and with it the candidates) is rebuilt; a wall may
         // close in by the other half (surface_list.hpp).
         if (m.moves() && !surf_.candidates.first.empty() &&
-            m.maxDisplacement(surf_.candidatesTime, w_.time, walls[q].reachFrom(m.centre)) > 0.5 * s_.skin)
+            m.maxDisplacement(surf_.candidatesTime, w_.time, surf_.reach[q]) > 0.5 * s_.skin)
             far = true;
     }
     if (far && surf_.slotOf.size() == w_.particles.tdmCount()) buildCandidates(nullptr, s_.skin);

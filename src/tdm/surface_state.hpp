@@ -40,6 +40,7 @@ struct SurfaceState {
     static constexpr std::uint32_t kNoSlots = 0xFFFFFFFFu;
     const std::vector<SurfaceWall<D>>* walls = nullptr;
     std::vector<Pose<D>> poses;    ///< each wall's pose at the time of the current force pass
+    std::vector<double> reach;     ///< each wall's farthest point from its centre of rotation (body frame) [m]
     SurfaceCandidates candidates;  ///< built at candidatesTime
     double candidatesTime = 0;     ///< [s]
     /// Particle i's contacts: slots[slotOf[i] ... + count[i]) (kSurfaceSlots reserved), kNoSlots without candidates.
@@ -60,7 +61,10 @@ struct SurfaceState {
         walls = w;
         boxFirst.assign(1, 0);
         boxes.clear();
+        reach.clear();
         for (const SurfaceWall<D>& wall : *w) {
+            // A wall's shape is fixed in its body frame: how far a rotation can move its points is known once.
+            reach.push_back(wall.reachFrom(wall.motion.centre));
             if (wall.kind == SurfaceKind::Mesh)
                 for (std::size_t e = 0; e < wall.elementCount(); ++e) {
                     ElementBox<D> b;
