@@ -108,6 +108,49 @@ TEST(Inlet, DeliversItsRateInParticlesWithoutOverlap) {
     EXPECT_EQ(*ids.rbegin(), 400u + 800u - 1u);
 }
 
+TEST(Outlet, CounterCountsEachParticleOnceAndKeepsIt) {
+    // A counter (remove = false) before the drain: a particle is counted the first time its centre is inside, again
+    // never, however often it crosses; it stays in the run and the drain still removes it later.
+    const std::string text = replaced(sceneText("pour3d.toml"), "[[outlet]]\nname = \"drain\"",
+                                      "[[outlet]]\nname = \"low\"\nremove = false\n"
+                                      "plane = { point = [0.0, 0.0, 0.01], normal = [0.0, 0.0, -1.0] }\n\n"
+                                      "[[outlet]]\nname = \"drain\"");
+    const Scenario sc = pour({"inlet[1].start=10", "inlet[1].end=11"}, text);
+    ASSERT_EQ(sc.outlets.size(), 2u);
+    EXPECT_FALSE(sc.outlets[0].remove);
+    World<3> w = buildWorld<3>(sc);
+    Particles<3>& p = w.particles;
+    StaticHost<3> host(w);
+    Flow<3> flow(sc, w, 1e-4);
+    for (std::size_t i = 0; i < p.size(); ++i) p.x[i] = Vec<3>{{0.02, 0.02, 0.015}};  // above the counter, off the pit
+    const double m0 = p.mass[0];
+    const std::uint64_t id0 = p.id[0];
+    for (int k = 0; k < 6; ++k) {  // particle 0 crosses the counter's plane down and up three times
+        p.x[0][2] = k % 2 == 0 ? 0.005 : 0.015;
+        w.time += 1e-4;
+        flow.act(w, host, 1e-9);
+    }
+    auto row = flow.row(w.time);  // feed x3, low_particles, low_mass, low_rate, drain x3
+    EXPECT_EQ(*row[3], 1);
+    EXPECT_EQ(*row[4], m0);
+    EXPECT_EQ(host.removed, 0u);
+    EXPECT_EQ(p.size(), 400u);
+    // Into the pit: the drain removes it; the counter, already past, does not count it again.
+    p.x[0] = Vec<3>{{0.004, 0.004, 0.002}};
+    w.time += 1e-4;
+    flow.act(w, host, 1e-9);
+    row = flow.row(w.time);
+    EXPECT_EQ(*row[3], 1);
+    EXPECT_EQ(*row[6], 1);
+    EXPECT_EQ(host.removed, 1u);
+    EXPECT_EQ(std::count(p.id.begin(), p.id.end(), id0), 0);
+    // Every other particle below the plane now: each counted once.
+    for (std::size_t i = 0; i < p.size(); ++i) p.x[i][2] = 0.005;
+    w.time += 1e-4;
+    flow.act(w, host, 1e-9);
+    EXPECT_EQ(*flow.row(w.time)[3], 400);
+}
+
 TEST(Inlet, DeliversItsRateInKilogramsPerSecond) {
     const std::string text = replaced(sceneText("pour3d.toml"), "rate = 4000", "mass_rate = 0.004");
     const Scenario sc = pour({"duration=0.2"}, text);

@@ -47,7 +47,7 @@ Flow<D>::Flow(const Scenario& sc, const World<D>& world, double dt) : sc_(sc), d
     }
     for (const OutletDef& d : sc.outlets) {
         lazyInterval_ = std::min(lazyInterval_, d.interval);
-        outlets_.push_back(Outlet{&d, {}});
+        outlets_.push_back(Outlet{&d, {}, 0, {}});
     }
     nextLazy_ = outlets_.empty() ? kNoTime : world.time + lazyInterval_;
 }
@@ -95,6 +95,13 @@ void Flow<D>::act(World<D>& world, FlowHost<D>& host, double tol) {
             if (p.frozen(i)) continue;  // a fixture never leaves
             for (Outlet& o : outlets_) {
                 if (!inside(*o.def, p.x[i])) continue;
+                if (!o.def->remove) {  // a counter: once per particle, and the particle goes on to the next outlets
+                    if (o.seen.insert(p.id[i]).second) {
+                        ++o.out.particles;
+                        o.out.mass += p.mass[i];
+                    }
+                    continue;
+                }
                 which.push_back(static_cast<std::uint32_t>(i));
                 ++o.out.particles;
                 o.out.mass += p.mass[i];
@@ -207,8 +214,9 @@ void Flow<D>::describe(JsonObject& j) const {
         JsonObject o;
         o.add("particles", out.out.particles);
         o.add("mass", out.out.mass);
+        if (!out.def->remove) o.add("counter", true);
         outlets.add(out.def->name, o);
-        removed += out.out.particles;
+        if (out.def->remove) removed += out.out.particles;
     }
     f.add("inserted", added);
     f.add("removed", removed);
@@ -278,8 +286,9 @@ void describeFlows(const Scenario& sc, std::ostream& out) {
     }
     for (const OutletDef& o : sc.outlets)
         out << fmt::format(
-            "outlet     {}: {}; time-driven particles checked every step, event-driven ones every {:.4g} s\n", o.name,
-            o.kind == OutletKind::Box ? "box" : "half-space beyond a plane", o.interval);
+            "outlet     {}: {}{}; time-driven particles checked every step, event-driven ones every {:.4g} s\n", o.name,
+            o.kind == OutletKind::Box ? "box" : "half-space beyond a plane",
+            o.remove ? "" : ", a counter (particles stay)", o.interval);
 }
 
 template class Flow<2>;

@@ -8,6 +8,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "core/rng.hpp"
@@ -77,7 +78,8 @@ private:
     struct Outlet {
         const OutletDef* def;
         FlowCount out;
-        double massAtRow = 0;  // out.mass at the last row [kg]
+        double massAtRow = 0;                    // out.mass at the last row [kg]
+        std::unordered_set<std::uint64_t> seen;  // a counter's: the ids it counted (ids are never reused)
     };
     bool inside(const OutletDef& o, const Vec<D>& x) const;
     void batch(World<D>& world, Inlet& in);

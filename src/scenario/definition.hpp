@@ -197,6 +197,9 @@ struct OutletDef {
     Vec3d point{0, 0, 0};            ///< half-space: a point on its plane [m]
     Vec3d normal{0, 0, 1};           ///< half-space: unit normal pointing into the removed side
     double interval = 0;             ///< [s] between checks of event-driven particles; 0: duration / 1000
+    /// false: a counter (LIGGGHTS massflow/mesh without delete_atoms): each particle is counted the first time its
+    /// centre is found inside, and stays in the run.
+    bool remove = true;
     SourcePos pos;
 };
 

@@ -152,10 +152,7 @@ void readSurface(const TableReader& r, int dim, const DomainDef& domain, InletDe
     const TableReader f(*r.subTable("surface"), r.keyPath("surface"), r.file());
     f.allowOnly({"center", "normal", "size", "length", "radius", "axis"});
     const Vec3d c = f.requiredVector("center", dim);
-    Vec3d n = f.requiredVector("normal", dim);
-    const double nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(nl > 0)) f.fail("normal", "must be nonzero");
-    for (double& x : n) x /= nl;
+    const Vec3d n = unitVector(f, "normal", f.requiredVector("normal", dim));
     double vn = 0;
     for (int k = 0; k < dim; ++k) vn += p.velocity[k] * n[k];
     if (!(vn > 0))
@@ -274,7 +271,7 @@ void readInletFlow(const TableReader& r, int dim, const Scenario& s, InletDef& i
 }
 
 OutletDef readOutlet(const TableReader& r, int dim, double duration) {
-    r.allowOnly({"name", "region", "plane", "interval"});
+    r.allowOnly({"name", "region", "plane", "interval", "remove"});
     OutletDef o;
     o.pos = r.tablePos();
     o.name = r.string("name").value_or("");
@@ -294,13 +291,11 @@ OutletDef readOutlet(const TableReader& r, int dim, double duration) {
         g.allowOnly({"point", "normal"});
         o.kind = OutletKind::HalfSpace;
         o.point = g.requiredVector("point", dim);
-        o.normal = g.requiredVector("normal", dim);
-        const double len = std::sqrt(o.normal[0] * o.normal[0] + o.normal[1] * o.normal[1] + o.normal[2] * o.normal[2]);
-        if (!(len > 0)) g.fail("normal", "must be nonzero");
-        for (double& c : o.normal) c /= len;
+        o.normal = unitVector(g, "normal", g.requiredVector("normal", dim));
     }
     o.interval = r.number("interval").value_or(duration / 1000);
     if (!(o.interval > 0)) r.fail("interval", "must be > 0");
+    o.remove = r.boolean("remove").value_or(true);
     return o;
 }
 

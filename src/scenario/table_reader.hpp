@@ -247,4 +247,16 @@ inline const toml::table& emptyTable() {
     return empty;
 }
 
+/// The unit vector along `key`'s value: scaled by its largest component first, so that [1e200, 1e200] is a
+/// direction and not an overflow to infinity. Fails with the key when the vector is zero (or not finite).
+inline Vec3d unitVector(const TableReader& r, std::string_view key, Vec3d v) {
+    double big = 0;
+    for (double c : v) big = std::max(big, std::abs(c));
+    if (!(big > 0) || !std::isfinite(big)) r.fail(key, "must be nonzero and finite");
+    for (double& c : v) c /= big;
+    const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (double& c : v) c /= len;
+    return v;
+}
+
 }  // namespace haet

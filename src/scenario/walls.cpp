@@ -16,18 +16,6 @@ Vec3d cross3(const Vec3d& a, const Vec3d& b) {
     return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
-/// The unit vector along `key`'s value: scaled by its largest component first, so that [1e200, 1e200] is a
-/// direction and not an overflow to infinity.
-Vec3d unitVector(const TableReader& r, std::string_view key, Vec3d v) {
-    double big = 0;
-    for (double c : v) big = std::max(big, std::abs(c));
-    if (!(big > 0)) r.fail(key, "must be nonzero");
-    for (double& c : v) c /= big;
-    const double len = norm3(v);
-    for (double& c : v) c /= len;
-    return v;
-}
-
 double positive(const TableReader& r, std::string_view key) {
     const double v = r.requiredNumber(key);
     if (!(v > 0)) r.fail(key, "must be > 0");
