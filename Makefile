@@ -25,8 +25,10 @@ validate: build
 	cd $(BUILD) && ctest -L validate --output-on-failure -j $(JOBS)
 
 demo: build
-	$(BUILD)/haet run examples/haet_demo.toml --out runs/demo
-	@echo "demo: runs/demo/final.png (blue: time-driven, orange: event-driven), series.csv, particles.pvd, zones.pvd, run.json"
+	$(BUILD)/haet run examples/silo2d.toml --out runs/demo
+	$(BUILD)/haet plot runs/demo/series.csv -x time -y orifice_rate -y drain_rate \
+	    --title "silo2d: discharge rate through the orifice and off the floor [kg/(m s)]" -o runs/demo/discharge.png
+	@echo "demo: runs/demo/final.png (blue: time-driven, orange: event-driven), discharge.png, series.csv, particles.pvd, walls.pvd, zones.pvd, run.json"
 
 bench: build
 	bench/run_all.sh $(BUILD)
