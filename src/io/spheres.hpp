@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,9 @@ struct SphereScene {
     std::string caption;
     PictureKey key;  ///< drawn in a strip at the right of the view, unless empty
 };
+
+/// The view along an axis named "x", "y", "z", "-x", "-y" or "-z"; nullopt for any other text.
+std::optional<std::array<double, 3>> axisView(const std::string& name);
 
 /// The projection of a scene: screen x to the right, y down [px] (pixel centres at k + 1/2) and depth along the
 /// view [px], with the box's projection inside a margin of kMargin px.

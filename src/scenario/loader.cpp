@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/spheres.hpp"
 #include "scenario/checks.hpp"
 #include "scenario/flow_loader.hpp"
 #include "scenario/table_reader.hpp"
@@ -551,13 +552,9 @@ private:
         if (r.has("view")) {
             if (dim_ != 3) r.fail("view", "only for dimension = 3 (a 2D picture shows the plane)");
             if (const toml::node* n = r.table().get("view"); n && n->is_string()) {
-                const std::string v = *r.string("view");
-                const bool neg = !v.empty() && v[0] == '-';
-                const std::string axis = neg ? v.substr(1) : v;
-                if (axis != "x" && axis != "y" && axis != "z")
-                    r.fail("view", "expected \"x\", \"y\", \"z\", \"-x\", \"-y\", \"-z\" or [dx, dy, dz]");
-                o.view = {0, 0, 0};
-                o.view[static_cast<std::size_t>(axis[0] - 'x')] = neg ? -1 : 1;
+                const auto v = axisView(*r.string("view"));
+                if (!v) r.fail("view", "expected \"x\", \"y\", \"z\", \"-x\", \"-y\", \"-z\" or [dx, dy, dz]");
+                o.view = *v;
             } else {
                 o.view = *r.vector("view", 3);
                 if (!(o.view[0] * o.view[0] + o.view[1] * o.view[1] + o.view[2] * o.view[2] > 0))
