@@ -130,6 +130,34 @@ TEST_F(Picture, WallsAreClippedToTheBoxAndOutlined) {
     EXPECT_GT(red(pixel(renderSpheres(back), 450, 450)), 150);
 }
 
+// A closed mesh (a cube of twelve triangles, wound outwards) is outlined where it turns away from the camera, not
+// along the diagonals of its faces.
+TEST_F(Picture, ClosedMeshesShowTheirSilhouette) {
+    SphereScene s = cube();
+    std::array<std::int64_t, 8> v{};
+    for (int c = 0; c < 8; ++c) v[c] = s.walls.point(c & 1 ? 0.7 : 0.3, c & 2 ? 0.7 : 0.3, c & 4 ? 0.7 : 0.3);
+    const int faces[6][4] = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
+    for (const auto& f : faces) {
+        // Wound so that the normal points out of the cube (away from its centre).
+        const auto& p = s.walls.points;
+        std::array<double, 3> a = p[v[f[0]]], b = p[v[f[1]]], c = p[v[f[2]]], mid{0, 0, 0};
+        for (int k = 0; k < 4; ++k)
+            for (int d = 0; d < 3; ++d) mid[d] += p[v[f[k]]][d] / 4;
+        const std::array<double, 3> u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const std::array<double, 3> n{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+        const bool out = n[0] * (mid[0] - 0.5) + n[1] * (mid[1] - 0.5) + n[2] * (mid[2] - 0.5) > 0;
+        const std::int64_t q0 = v[f[0]], q1 = v[f[out ? 1 : 3]], q2 = v[f[2]], q3 = v[f[out ? 3 : 1]];
+        s.walls.poly({q0, q1, q2}, 0);
+        s.walls.poly({q0, q2, q3}, 0);
+    }
+    const SphereImage img = renderSpheres(s);
+    EXPECT_LT(red(pixel(img, 273, 450)), 0x60);  // the left side, x = 0.3: 8 + 0.3 * 884 = 273.2 px
+    EXPECT_LT(red(pixel(img, 450, 626)), 0x60);  // the bottom, z = 0.3
+    EXPECT_GT(red(pixel(img, 450, 450)), 0xa0);  // on the front face's diagonal: tinted, not outlined
+    EXPECT_GT(red(pixel(img, 350, 400)), 0xa0);
+    EXPECT_LT(red(pixel(img, 350, 400)), 0xff);
+}
+
 TEST_F(Picture, ViewSizeIsCapped) {
     SphereScene s = cube();
     s.hi = {1, 1, 40};  // a tall column: its height, not its width, sets the scale

@@ -205,10 +205,11 @@ V3 newell(const std::vector<V3>& pts) {
 }
 
 /// Whether each edge of the walls' polygons is outlined: a rim (an edge of one polygon only) or a silhouette (between
-/// a polygon that faces the camera and one that faces away). Keyed by wall and point ids, in a fixed order.
+/// a polygon that faces the camera and one that does not: faces away or is seen edge on, as the sides of a box seen
+/// face on). Keyed by wall and point ids, in a fixed order.
 std::map<std::tuple<std::int32_t, std::int64_t, std::int64_t>, bool> outlinedEdges(const WallShapes& sh, const V3& d) {
     struct Use {
-        int count = 0, front = 0, back = 0;
+        int count = 0, front = 0, other = 0;
     };
     std::map<std::tuple<std::int32_t, std::int64_t, std::int64_t>, Use> uses;
     for (std::size_t c = 0; c + 1 < sh.polyFirst.size(); ++c) {
@@ -222,11 +223,11 @@ std::map<std::tuple<std::int32_t, std::int64_t, std::int64_t>, bool> outlinedEdg
             Use& u = uses[{sh.polyWall[c], std::min(a, b), std::max(a, b)}];
             ++u.count;
             u.front += facing < -tol;
-            u.back += facing > tol;
+            u.other += facing >= -tol;
         }
     }
     std::map<std::tuple<std::int32_t, std::int64_t, std::int64_t>, bool> out;
-    for (const auto& [key, u] : uses) out[key] = u.count == 1 || (u.front > 0 && u.back > 0);
+    for (const auto& [key, u] : uses) out[key] = u.count == 1 || (u.front > 0 && u.other > 0);
     return out;
 }
 
