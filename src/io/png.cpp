@@ -126,10 +126,22 @@ KeySize keySize(const PictureKey& key) {
     return {kKeyWidth, kKeyTitle + body};
 }
 
+namespace {
+
+/// Sets the font size to `size`, or smaller (down to 7) when `s` would be wider than `width` px.
+void fitFont(cairo_t* cr, const std::string& s, double size, double width) {
+    cairo_set_font_size(cr, size);
+    cairo_text_extents_t e;
+    cairo_text_extents(cr, s.c_str(), &e);
+    if (e.x_advance > width) cairo_set_font_size(cr, std::max(7.0, size * width / e.x_advance));
+}
+
+}  // namespace
+
 void drawKey(cairo_t* cr, const PictureKey& key, double x0, double height) {
     if (key.empty()) return;
     cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr, 13);
+    fitFont(cr, key.title, 13, kKeyWidth - 20);
     setColor(cr, kInk);
     drawText(cr, key.title, x0 + 12, 12, 0, 0);
     cairo_set_font_size(cr, 12);
@@ -143,6 +155,7 @@ void drawKey(cairo_t* cr, const PictureKey& key, double x0, double height) {
             setColor(cr, kInk);
             cairo_set_line_width(cr, 0.75);
             cairo_stroke(cr);
+            fitFont(cr, key.categories[k].label, 12, kKeyWidth - 42);
             drawText(cr, key.categories[k].label, x0 + 34, y, 0, 0.5);
         }
         return;
