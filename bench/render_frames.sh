@@ -10,22 +10,19 @@
 # Environment: SPHERES (20000), ROUNDS (5), MACHINE, NOTE. Exit status: 0 measured; 1 a run failed; 2 usage.
 set -euo pipefail
 
-[ $# -eq 1 ] || { echo "usage: $0 BUILD_DIR" >&2; exit 2; }
-[ -d "$1" ] || { echo "$0: build directory not found: $1" >&2; exit 2; }
-build=$(cd "$1" && pwd)
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-root=$(cd "$here/.." && pwd)
 # shellcheck source=bench/lib.sh
 . "$here/lib.sh"
+[ $# -eq 1 ] || { echo "usage: $0 BUILD_DIR" >&2; exit 2; }
+[ -d "$1" ] || { echo "$0: build directory not found: $1" >&2; exit 2; }
+setup "$0" "$1" "$here/data/runs/render_frames"
 SPHERES=${SPHERES:-20000}
 ROUNDS=${ROUNDS:-5}
 machine=${MACHINE:-$(machine_name)}
 csv=$here/results/$machine/render.csv
-runs=$here/data/runs/render_frames
-haet=$build/haet
+runs=$out
 [ -x "$haet" ] || { echo "$0: $haet not found" >&2; exit 1; }
-[ -x /usr/bin/time ] || { echo "$0: /usr/bin/time not found (apt-get install time)" >&2; exit 1; }
-mkdir -p "$runs" "$(dirname "$csv")"
+mkdir -p "$(dirname "$csv")"
 load_before=$(cut -d' ' -f1 /proc/loadavg)
 
 # Five snapshots 0.5 ms apart: the spheres where they were placed, falling.

@@ -16,26 +16,16 @@
 #include "io/png.hpp"
 #include "io/spheres.hpp"
 #include "run/picture.hpp"
+#include "temp_dir.hpp"
 
 namespace haet {
 namespace {
 
 namespace fs = std::filesystem;
 
-class Picture : public ::testing::Test {
+class Picture : public testing::TempDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / (std::string("haet_pic_") + info->name() + "_" + std::to_string(getpid()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-    static std::string slurp(const fs::path& p) {
-        std::ifstream in(p, std::ios::binary);
-        return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    }
-    fs::path dir_;
+    Picture() : TempDirTest("pic") {}
 };
 
 /// The unit cube seen along +y (x to the right, z up) at 900 px: 884 px/m inside an 8 px margin.
