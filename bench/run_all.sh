@@ -10,8 +10,9 @@
 # 5. bench/compare_liggghts.sh BUILD_DIR    HAET against LIGGGHTS, the 3D silo of two STL meshes (6 000 spheres)
 # 6. bench/mesh_floor.sh BUILD_DIR          a settled bed on a 10 082-triangle mesh floor against its plane (wall time;
 #                                           instruction counts too when BUILD_DIR-v3, an x86-64-v3 build, exists)
-# 7. BUILD_DIR/haet_bench                   Google Benchmark micro-benchmarks, when built
-# 8. BUILD_DIR/haet_bench PolygonSettle2D   10 000 hexagons vs 10 000 disks settling, 1 and 2 threads, side by
+# 7. bench/render_frames.sh BUILD_DIR      haet render of 20 000 spheres: CPU and wall time per frame
+# 8. BUILD_DIR/haet_bench                   Google Benchmark micro-benchmarks, when built
+# 9. BUILD_DIR/haet_bench PolygonSettle2D   10 000 hexagons vs 10 000 disks settling, 1 and 2 threads, side by
 #                                           side in one run, with the polygon/disk cost ratio
 # The first run on a machine prepares the flowing states with LAMMPS (10-15 min for 3D, once; kept in
 # bench/data/) and LIGGGHTS (a few minutes), and the settled bed (about a minute). Installs the Debian packages
@@ -55,6 +56,10 @@ echo
 
 echo "=== mesh floor vs plane floor"
 "$here/mesh_floor.sh" "$build" || failed="$failed mesh_floor"
+echo
+
+echo "=== pictures: haet render of 20 000 spheres"
+"$here/render_frames.sh" "$build" || failed="$failed render"
 echo
 
 if [ -x "$build/haet_bench" ]; then

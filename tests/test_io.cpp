@@ -18,6 +18,7 @@
 #include "io/png.hpp"
 #include "io/series.hpp"
 #include "io/vtk.hpp"
+#include "temp_dir.hpp"
 
 namespace haet {
 namespace {
@@ -25,27 +26,14 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh directory per test, removed afterwards.
-class IoTest : public ::testing::Test {
+class IoTest : public testing::TempDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / (std::string("haet_io_") + info->name() + "_" + std::to_string(::getpid()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    static std::string slurp(const fs::path& p) {
-        std::ifstream in(p, std::ios::binary);
-        return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    }
+    IoTest() : TempDirTest("io") {}
     std::vector<fs::path> listDir() const {
         std::vector<fs::path> out;
         for (const auto& e : fs::directory_iterator(dir_)) out.push_back(e.path().filename());
         return out;
     }
-
-    fs::path dir_;
 };
 
 template <class T>

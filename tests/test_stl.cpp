@@ -14,23 +14,16 @@
 
 #include "core/rng.hpp"
 #include "io/stl.hpp"
+#include "temp_dir.hpp"
 
 namespace haet {
 namespace {
 
 namespace fs = std::filesystem;
 
-class Stl : public ::testing::Test {
+class Stl : public testing::TempDirTest {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("haet_stl_" + std::string(info->name()) + "_" + std::to_string(getpid()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override {
-        if (!HasFailure()) fs::remove_all(dir_);
-    }
+    Stl() : TempDirTest("stl", true) {}
     fs::path write(const std::string& name, const std::string& bytes) {
         const fs::path p = dir_ / name;
         std::ofstream(p, std::ios::binary) << bytes;
@@ -47,7 +40,6 @@ protected:
         ADD_FAILURE() << p << " was read without error";
         return {};
     }
-    fs::path dir_;
     StlError last_{fs::path(), "", 0, 0};
 };
 

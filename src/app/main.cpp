@@ -1,11 +1,12 @@
-// The `haet` command line: run and check scenarios, plot CSV tables. Exit codes (docs/scenario.md, "Running"): 0 ok,
-// 1 an unexpected failure, 2 bad input, 3 the simulation blew up, 4 an output could not be written, 130 / 143 a run
-// stopped by SIGINT / SIGTERM.
+// The `haet` command line: run and check scenarios, render a run's snapshots, plot CSV tables. Exit codes
+// (docs/scenario.md, "Running"): 0 ok, 1 an unexpected failure, 2 bad input, 3 the simulation blew up, 4 an output
+// could not be written, 130 / 143 a run stopped by SIGINT / SIGTERM.
 #include <malloc.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "io/atomic_file.hpp"
 #include "io/png.hpp"
 #include "io/table.hpp"
+#include "run/render.hpp"
 #include "run/runner.hpp"
 #include "scenario/loader.hpp"
 
@@ -72,14 +74,32 @@ int main(int argc, char** argv) {
     std::string plotFile, plotOut, plotX = "time", plotTitle;
     std::vector<std::string> plotY;
     bool logX = false, logY = false;
-    auto* plot = app.add_subcommand("plot", "plot columns of a CSV file (series.csv, benchmark tables) as a PNG");
-    plot->add_option("csv", plotFile, "CSV file with a header row")->required();
+    auto* plot = app.add_subcommand(
+        "plot", "plot columns of a run's series.csv (or of any CSV file, such as a benchmark table) as a PNG");
+    plot->add_option("source", plotFile, "run directory (its series.csv) or CSV file with a header row")->required();
     plot->add_option("-x,--x", plotX, "column on the x axis (default: time)");
-    plot->add_option("-y,--y", plotY, "columns on the y axis")->required();
-    plot->add_option("-o,--out", plotOut, "PNG file to write")->required();
+    plot->add_option("-y,--y", plotY, "columns on the y axis (repeatable)")->required();
+    plot->add_option("-o,--out", plotOut, "PNG file to write (default: COLUMN.png beside the CSV file)");
     plot->add_option("--title", plotTitle, "title (default: the file name)");
     plot->add_flag("--logx", logX, "logarithmic x axis");
     plot->add_flag("--logy", logY, "logarithmic y axis");
+
+    std::string renderDir, renderOut, renderField, renderView, renderRange;
+    int renderWidth = 0;
+    double fps = 10;
+    bool noMovie = false;
+    auto* render = app.add_subcommand(
+        "render", "draw every snapshot of a run as PNG, and an MP4 movie of them when ffmpeg is installed");
+    render->add_option("rundir", renderDir, "run directory (what `haet run` wrote)")->required();
+    render->add_option("--field", renderField,
+                       "colour by this snapshot field: mode, material, velocity, velocity_z, force, radius, id, ... "
+                       "(default: the run's [output] color_by)");
+    render->add_option("--view", renderView, "3D: look along x, y, z, -x, -y, -z or DX,DY,DZ (default: the run's)");
+    render->add_option("--range", renderRange, "colour bar limits LO,HI (default: the field's range over the run)");
+    render->add_option("--width", renderWidth, "width of the view in px, 64 to 4096 (default: the run's)");
+    render->add_option("--out", renderOut, "output directory (default: RUNDIR/render)");
+    render->add_option("--fps", fps, "frames per second of movie.mp4 (default: 10)");
+    render->add_flag("--no-movie", noMovie, "only the PNGs, even when ffmpeg is installed");
 
     try {
         app.parse(argc, argv);
@@ -96,13 +116,44 @@ int main(int argc, char** argv) {
                                           : (quiet ? haet::ProgressDisplay::Off : haet::ProgressDisplay::Auto)};
             return static_cast<int>(haet::runScenario(sc, opt, std::cerr));
         }
+        if (*render) {
+            haet::RenderOptions ro;
+            ro.runDir = renderDir;
+            ro.outDir = renderOut;
+            if (!renderField.empty()) ro.field = renderField;
+            if (!renderView.empty()) {
+                ro.view = haet::parseView(renderView);
+                if (!ro.view)
+                    throw std::invalid_argument("--view " + renderView +
+                                                ": expected x, y, z, -x, -y, -z or "
+                                                "three numbers DX,DY,DZ, not all zero");
+            }
+            if (!renderRange.empty()) {
+                ro.range = haet::parseRange(renderRange);
+                if (!ro.range) throw std::invalid_argument("--range " + renderRange + ": expected LO,HI with HI > LO");
+            }
+            if (render->count("--width")) ro.widthPx = renderWidth;
+            ro.fps = fps;
+            ro.movie = !noMovie;
+            haet::renderRun(ro, std::cerr);
+            return 0;
+        }
         if (*plot) {
-            const haet::CsvTable t = haet::readCsvTable(plotFile);
+            std::filesystem::path csv = plotFile;
+            if (std::filesystem::is_directory(csv)) csv /= "series.csv";
+            if (!std::filesystem::is_regular_file(csv))
+                throw std::invalid_argument(csv.string() + ": no such file (a run directory holds series.csv)");
+            const haet::CsvTable t = haet::readCsvTable(csv);
             auto col = [&](const std::string& name) {
                 const int c = t.column(name);
-                if (c < 0) throw std::invalid_argument(plotFile + ": no column '" + name + "'");
+                if (c < 0) {
+                    std::string have;
+                    for (const std::string& h : t.columns) have += (have.empty() ? "" : ", ") + h;
+                    throw std::invalid_argument(csv.string() + ": no column '" + name + "'; it has " + have);
+                }
                 return t.values(c);
             };
+            if (plotOut.empty()) plotOut = (csv.parent_path() / (plotY[0] + ".png")).string();
             const std::uint32_t colours[] = {0x1f77b4, 0xd62728, 0x2ca02c, 0xff7f0e, 0x9467bd, 0x8c564b};
             std::vector<haet::PlotSeries> series;
             const std::vector<double> x = col(plotX);
@@ -112,7 +163,7 @@ int main(int argc, char** argv) {
             o.logX = logX;
             o.logY = logY;
             o.markers = t.rows.size() <= 60;
-            haet::writeLinePlotPng(plotOut, plotTitle.empty() ? plotFile : plotTitle, plotX,
+            haet::writeLinePlotPng(plotOut, plotTitle.empty() ? csv.string() : plotTitle, plotX,
                                    plotY.size() == 1 ? plotY[0] : std::string(), series, o);
             return 0;
         }

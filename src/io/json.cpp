@@ -10,7 +10,9 @@ namespace haet {
 
 struct JsonObject::Member {
     std::string key;
-    std::variant<bool, std::int64_t, std::uint64_t, double, std::string, std::vector<double>, JsonObject> value;
+    std::variant<bool, std::int64_t, std::uint64_t, double, std::string, std::vector<double>, std::vector<std::string>,
+                 JsonObject>
+        value;
 };
 
 JsonObject::JsonObject() = default;
@@ -48,6 +50,10 @@ JsonObject& JsonObject::add(std::string_view key, const JsonObject& value) {
     return *this;
 }
 JsonObject& JsonObject::add(std::string_view key, const std::vector<double>& values) {
+    slot(key).value = values;
+    return *this;
+}
+JsonObject& JsonObject::add(std::string_view key, const std::vector<std::string>& values) {
     slot(key).value = values;
     return *this;
 }
@@ -142,6 +148,13 @@ void JsonObject::dumpTo(std::string& out, int indent, int depth) const {
                     for (std::size_t i = 0; i < v.size(); ++i) {
                         if (i > 0) out += pretty ? ", " : ",";
                         appendNumber(out, v[i]);
+                    }
+                    out += ']';
+                } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+                    out += '[';
+                    for (std::size_t i = 0; i < v.size(); ++i) {
+                        if (i > 0) out += pretty ? ", " : ",";
+                        out += jsonQuote(v[i]);
                     }
                     out += ']';
                 } else

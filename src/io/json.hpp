@@ -27,6 +27,7 @@ public:
     JsonObject& add(std::string_view key, const char* value) { return add(key, std::string_view(value)); }
     JsonObject& add(std::string_view key, const JsonObject& value);
     JsonObject& add(std::string_view key, const std::vector<double>& values);
+    JsonObject& add(std::string_view key, const std::vector<std::string>& values);
     /// Any integer type, written exactly (not through double).
     template <std::integral T>
     requires(!std::same_as<T, bool>) JsonObject& add(std::string_view key, T value) {

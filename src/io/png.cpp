@@ -14,38 +14,14 @@
 #include <vector>
 
 #include "io/atomic_file.hpp"
+#include "io/canvas.hpp"
 
 namespace haet {
 
 namespace {
 
-constexpr int kMaxPx = 16384;  // well inside Cairo's 32767 limit, and a 1 GiB ARGB buffer at most
 constexpr double kPi = 3.14159265358979323846;
-constexpr std::uint32_t kInk = 0x262626;  // outlines, axes and text
-constexpr std::size_t kMaxMarkers = 60;   // denser series would be hidden under their own dots
-
-struct Canvas {
-    std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface{nullptr, cairo_surface_destroy};
-    std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr{nullptr, cairo_destroy};
-};
-
-Canvas makeCanvas(const std::filesystem::path& path, int width, int height) {
-    if (width < 1 || height < 1 || width > kMaxPx || height > kMaxPx)
-        throw std::invalid_argument(
-            fmt::format("{}: image size {}x{} px is outside 1..{}", path.string(), width, height, kMaxPx));
-    Canvas c;
-    c.surface.reset(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height));
-    c.cr.reset(cairo_create(c.surface.get()));
-    if (cairo_status(c.cr.get()) != CAIRO_STATUS_SUCCESS)
-        throw IoError(path, std::string("cannot create image: ") + cairo_status_to_string(cairo_status(c.cr.get())));
-    cairo_set_source_rgb(c.cr.get(), 1, 1, 1);
-    cairo_paint(c.cr.get());
-    return c;
-}
-
-void setColor(cairo_t* cr, std::uint32_t rgb, double alpha = 1.0) {
-    cairo_set_source_rgba(cr, ((rgb >> 16) & 0xff) / 255.0, ((rgb >> 8) & 0xff) / 255.0, (rgb & 0xff) / 255.0, alpha);
-}
+constexpr std::size_t kMaxMarkers = 60;  // denser series would be hidden under their own dots
 
 void pngWrite(png_structp png, png_bytep data, png_size_t length) {
     auto* out = static_cast<AtomicOfstream*>(png_get_io_ptr(png));
@@ -86,6 +62,26 @@ bool encodePng(const unsigned char* pixels, int width, int height, int stride, A
     return true;
 }
 
+}  // namespace
+
+Canvas makeCanvas(const std::filesystem::path& path, int width, int height) {
+    if (width < 1 || height < 1 || width > kMaxPx || height > kMaxPx)
+        throw std::invalid_argument(
+            fmt::format("{}: image size {}x{} px is outside 1..{}", path.string(), width, height, kMaxPx));
+    Canvas c;
+    c.surface.reset(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height));
+    c.cr.reset(cairo_create(c.surface.get()));
+    if (cairo_status(c.cr.get()) != CAIRO_STATUS_SUCCESS)
+        throw IoError(path, std::string("cannot create image: ") + cairo_status_to_string(cairo_status(c.cr.get())));
+    cairo_set_source_rgb(c.cr.get(), 1, 1, 1);
+    cairo_paint(c.cr.get());
+    return c;
+}
+
+void setColor(cairo_t* cr, std::uint32_t rgb, double alpha) {
+    cairo_set_source_rgba(cr, ((rgb >> 16) & 0xff) / 255.0, ((rgb >> 8) & 0xff) / 255.0, (rgb & 0xff) / 255.0, alpha);
+}
+
 void savePng(cairo_surface_t* surface, const std::filesystem::path& path) {
     cairo_surface_flush(surface);
     AtomicOfstream out(path);
@@ -96,8 +92,6 @@ void savePng(cairo_surface_t* surface, const std::filesystem::path& path) {
     out.commit();
 }
 
-/// Draws `s` so that the point (x, y) [px] sits at fraction (ax, ay) of its box: (0, 0) top left,
-/// (0.5, 0.5) centre, (1, 1) bottom right.
 void drawText(cairo_t* cr, const std::string& s, double x, double y, double ax, double ay) {
     cairo_text_extents_t e;
     cairo_text_extents(cr, s.c_str(), &e);
@@ -105,7 +99,90 @@ void drawText(cairo_t* cr, const std::string& s, double x, double y, double ax, 
     cairo_show_text(cr, s.c_str());
 }
 
+void drawCaption(cairo_t* cr, const std::string& caption, int widthPx) {
+    if (caption.empty()) return;
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, std::clamp(widthPx / 50.0, 10.0, 24.0));
+    cairo_text_extents_t e;
+    cairo_text_extents(cr, caption.c_str(), &e);
+    const double pad = 4;
+    cairo_rectangle(cr, pad, pad, e.width + 2 * pad, e.height + 2 * pad);
+    cairo_set_source_rgba(cr, 1, 1, 1, 0.8);  // keeps the caption legible over particles
+    cairo_fill(cr);
+    setColor(cr, kInk);
+    drawText(cr, caption, 2 * pad, 2 * pad, 0, 0);
+}
+
+namespace {
+
+// The key's layout [px]: a title row, then legend rows or a bar of at most kBarMax px.
+constexpr int kKeyWidth = 170, kKeyTitle = 34, kKeyRow = 20, kBarMin = 120, kBarMax = 320, kBarWidth = 18;
+
 }  // namespace
+
+KeySize keySize(const PictureKey& key) {
+    if (key.empty()) return {};
+    const int body = key.categories.empty() ? kBarMin + 20 : kKeyRow * static_cast<int>(key.categories.size()) + 10;
+    return {kKeyWidth, kKeyTitle + body};
+}
+
+namespace {
+
+/// Sets the font size to `size`, or smaller (down to 7) when `s` would be wider than `width` px.
+void fitFont(cairo_t* cr, const std::string& s, double size, double width) {
+    cairo_set_font_size(cr, size);
+    cairo_text_extents_t e;
+    cairo_text_extents(cr, s.c_str(), &e);
+    if (e.x_advance > width) cairo_set_font_size(cr, std::max(7.0, size * width / e.x_advance));
+}
+
+}  // namespace
+
+void drawKey(cairo_t* cr, const PictureKey& key, double x0, double height) {
+    if (key.empty()) return;
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    fitFont(cr, key.title, 13, kKeyWidth - 20);
+    setColor(cr, kInk);
+    drawText(cr, key.title, x0 + 12, 12, 0, 0);
+    cairo_set_font_size(cr, 12);
+    if (!key.categories.empty()) {
+        for (std::size_t k = 0; k < key.categories.size(); ++k) {
+            const double y = kKeyTitle + kKeyRow * (k + 0.5);
+            cairo_new_sub_path(cr);
+            cairo_arc(cr, x0 + 20, y, 6, 0, 2 * kPi);
+            setColor(cr, key.categories[k].rgb);
+            cairo_fill_preserve(cr);
+            setColor(cr, kInk);
+            cairo_set_line_width(cr, 0.75);
+            cairo_stroke(cr);
+            fitFont(cr, key.categories[k].label, 12, kKeyWidth - 42);
+            drawText(cr, key.categories[k].label, x0 + 34, y, 0, 0.5);
+        }
+        return;
+    }
+    // The bar, hi at the top: one row of pixels per colour, from the same map as the particles.
+    const double top = kKeyTitle, barH = std::clamp(height - kKeyTitle - 20, double(kBarMin), double(kBarMax));
+    const double x = x0 + 14;
+    const int rows = static_cast<int>(barH);
+    for (int r = 0; r < rows; ++r) {
+        const double v = key.bar.hi - (r + 0.5) / rows * (key.bar.hi - key.bar.lo);
+        setColor(cr, key.bar.rgb(v));
+        cairo_rectangle(cr, x, top + r, kBarWidth, 1);
+        cairo_fill(cr);
+    }
+    setColor(cr, kInk);
+    cairo_set_line_width(cr, 1);
+    cairo_rectangle(cr, x + 0.5, top + 0.5, kBarWidth, rows);
+    cairo_stroke(cr);
+    for (double t : colourBarTicks(key.bar.lo, key.bar.hi)) {
+        const double f = key.bar.hi > key.bar.lo ? (key.bar.hi - t) / (key.bar.hi - key.bar.lo) : 0.5;
+        const double y = std::round(top + f * rows) + 0.5;
+        cairo_move_to(cr, x + kBarWidth, y);
+        cairo_line_to(cr, x + kBarWidth + 5, y);
+        cairo_stroke(cr);
+        drawText(cr, fmt::format("{:.4g}", t), x + kBarWidth + 8, y, 0, 0.5);
+    }
+}
 
 void writePng(const std::filesystem::path& path, const PngScene& scene) {
     const double spanX = scene.hi[0] - scene.lo[0];
@@ -116,7 +193,9 @@ void writePng(const std::filesystem::path& path, const PngScene& scene) {
     if (spanY / spanX * widthPx > kMaxPx) widthPx = std::max(1, static_cast<int>(std::floor(kMaxPx * spanX / spanY)));
     const double scale = widthPx / spanX;  // [px/m]
     const double heightPx = std::round(spanY * scale);
-    Canvas canvas = makeCanvas(path, widthPx, static_cast<int>(std::clamp(heightPx, 1.0, double(kMaxPx))));
+    const KeySize key = keySize(scene.key);
+    const int canvasHeight = std::max(static_cast<int>(std::clamp(heightPx, 1.0, double(kMaxPx))), key.height);
+    Canvas canvas = makeCanvas(path, widthPx + key.width, canvasHeight);
     const double reach = 4.0 * std::max(widthPx, kMaxPx);  // beyond this a disk covers the picture [px]
     cairo_t* cr = canvas.cr.get();
     auto px = [&](double x) { return (x - scene.lo[0]) * scale; };
@@ -161,32 +240,12 @@ void writePng(const std::filesystem::path& path, const PngScene& scene) {
         cairo_stroke(cr);
     }
 
-    if (!scene.caption.empty()) {
-        cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-        cairo_set_font_size(cr, std::clamp(widthPx / 50.0, 10.0, 24.0));
-        cairo_text_extents_t e;
-        cairo_text_extents(cr, scene.caption.c_str(), &e);
-        const double pad = 4;
-        cairo_rectangle(cr, pad, pad, e.width + 2 * pad, e.height + 2 * pad);
-        cairo_set_source_rgba(cr, 1, 1, 1, 0.8);  // keeps the caption legible over particles
-        cairo_fill(cr);
-        setColor(cr, kInk);
-        drawText(cr, scene.caption, 2 * pad, 2 * pad, 0, 0);
-    }
+    drawCaption(cr, scene.caption, widthPx);
+    drawKey(cr, scene.key, widthPx, canvasHeight);
     savePng(canvas.surface.get(), path);
 }
 
 namespace {
-
-struct Axis {
-    double lo = 0, hi = 1;
-    bool log = false;
-    std::vector<double> ticks;
-
-    double fraction(double v) const {
-        return log ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo)) : (v - lo) / (hi - lo);
-    }
-};
 
 bool usable(double v, bool log) { return std::isfinite(v) && (!log || v > 0); }
 
@@ -198,9 +257,21 @@ double niceStep(double range) {
     return (m < 1.5 ? 1 : m < 3.5 ? 2 : m < 7.5 ? 5 : 10) * mag;
 }
 
-/// Axis limits rounded out to ticks, from the finite data range [lo, hi] (lo > hi when there is no data).
-Axis makeAxis(double lo, double hi, bool log) {
-    Axis a;
+}  // namespace
+
+std::vector<double> colourBarTicks(double lo, double hi) {
+    // A bar narrower than a billionth of its values would take its ticks from steps that k * step cannot tell apart.
+    if (!(hi - lo > 1e-9 * std::max(std::abs(lo), std::abs(hi))) || !std::isfinite(hi - lo)) return {lo};
+    const double step = niceStep(hi - lo);
+    std::vector<double> ticks;
+    // Within the bar, to a millionth of a step (so that lo and hi themselves count when they are multiples).
+    for (double k = std::ceil(lo / step - 1e-6); k <= std::floor(hi / step + 1e-6); k += 1)
+        ticks.push_back(std::abs(k) < 0.5 ? 0.0 : k * step);
+    return ticks;
+}
+
+PlotAxis plotAxis(double lo, double hi, bool log) {
+    PlotAxis a;
     a.log = log;
     if (log) {
         if (lo > hi) lo = 1, hi = 10;
@@ -214,9 +285,9 @@ Axis makeAxis(double lo, double hi, bool log) {
         return a;
     }
     if (lo > hi) lo = 0, hi = 1;
-    if (lo == hi) {
-        const double d = lo == 0 ? 1 : 0.1 * std::abs(lo);
-        lo -= d, hi += d;
+    if (!(hi - lo > 1e-9 * std::max(std::abs(lo), std::abs(hi)))) {  // one value, or a few ulps: about it
+        const double mid = 0.5 * (lo + hi), d = mid == 0 ? 1 : 0.1 * std::abs(mid);
+        lo = mid - d, hi = mid + d;
     }
     const double step = niceStep(hi - lo);
     const double k0 = std::floor(lo / step), k1 = std::ceil(hi / step);
@@ -225,8 +296,6 @@ Axis makeAxis(double lo, double hi, bool log) {
     for (double k = k0; k <= k1 + 0.5; k += 1) a.ticks.push_back(std::abs(k) < 0.5 ? 0.0 : k * step);
     return a;
 }
-
-}  // namespace
 
 void writeLinePlotPng(const std::filesystem::path& path, const std::string& title, const std::string& xlabel,
                       const std::string& ylabel, const std::vector<PlotSeries>& series,
@@ -239,8 +308,8 @@ void writeLinePlotPng(const std::filesystem::path& path, const std::string& titl
                 xLo = std::min(xLo, s.x[i]), xHi = std::max(xHi, s.x[i]);
                 yLo = std::min(yLo, s.y[i]), yHi = std::max(yHi, s.y[i]);
             }
-    const Axis ax = makeAxis(xLo, xHi, options.logX);
-    const Axis ay = makeAxis(yLo, yHi, options.logY);
+    const PlotAxis ax = plotAxis(xLo, xHi, options.logX);
+    const PlotAxis ay = plotAxis(yLo, yHi, options.logY);
 
     Canvas canvas = makeCanvas(path, options.widthPx, options.heightPx);
     cairo_t* cr = canvas.cr.get();

@@ -2,10 +2,13 @@
 // Quick-look pictures with Cairo: a 2D state (disks, polygons, walls) and simple line plots for the
 // benchmark results. Files are written atomically.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
+
+#include "io/colour.hpp"
 
 namespace haet {
 
@@ -32,11 +35,12 @@ struct PngScene {
     std::vector<Polygon> polygons;
     std::vector<Segment> walls;
     std::string caption;  ///< drawn at the top left (time, step count, ...)
+    PictureKey key;       ///< drawn in a strip at the right of the view, unless empty
 };
 
-/// Draws the scene on white with thin dark outlines. A view that would be taller than 16384 px at widthPx is drawn
-/// narrower (16384 px tall); disks with non-finite or far-away coordinates are left out. Throws
-/// std::invalid_argument for an empty view, IoError if the file cannot be written.
+/// Draws the scene on white (and its key to the right of the view) with thin dark outlines. A view that would be taller
+/// than 16384 px at widthPx is drawn narrower (16384 px tall); disks with non-finite or far-away coordinates are left
+/// out. Throws std::invalid_argument for an empty view, IoError if the file cannot be written.
 void writePng(const std::filesystem::path& path, const PngScene& scene);
 
 /// One line of a plot. Points with a non-finite coordinate (or a non-positive one on a log axis) are
@@ -54,6 +58,24 @@ struct LinePlotOptions {
     bool logY = false;
     bool markers = true;  ///< a dot on every data point, for series of at most 60 points
 };
+
+/// An axis of a line plot: limits rounded out to ticks from the finite data range [lo, hi] (lo > hi when there is no
+/// data): ticks at 1, 2 or 5 times a power of ten, about six of them; on a log axis at decades.
+struct PlotAxis {
+    double lo = 0, hi = 1;
+    bool log = false;
+    std::vector<double> ticks;
+
+    /// Where v lies between lo (0) and hi (1).
+    double fraction(double v) const {
+        return log ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo)) : (v - lo) / (hi - lo);
+    }
+};
+PlotAxis plotAxis(double lo, double hi, bool log);
+
+/// The labelled ticks of a colour bar over [lo, hi]: the multiples within it of the step plotAxis would take; {lo}
+/// alone when hi <= lo.
+std::vector<double> colourBarTicks(double lo, double hi);
 
 /// A line plot with axes, ticks, grid, axis labels and a legend. Throws as writePng().
 void writeLinePlotPng(const std::filesystem::path& path, const std::string& title, const std::string& xlabel,

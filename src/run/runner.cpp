@@ -18,12 +18,13 @@
 #include "edm/engine.hpp"
 #include "haet/engine.hpp"
 #include "io/atomic_file.hpp"
+#include "io/frame.hpp"
 #include "io/json.hpp"
-#include "io/png.hpp"
 #include "io/series.hpp"
 #include "io/vtk.hpp"
 #include "polygon/output.hpp"
 #include "run/flow.hpp"
+#include "run/picture.hpp"
 #include "run/run_dir.hpp"
 #include "run/schedule.hpp"
 #include "run/stop.hpp"
@@ -275,6 +276,47 @@ std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world, const
     throw ScenarioError({sc.path, 0}, "method", "unknown method");
 }
 
+/// The particles as a snapshot holds them (particles_NNNNNN.vtu) and final.png draws them: positions, radius,
+/// velocity, angular_velocity, force (zero in a pure event-driven run, which keeps none), material, id, and in a
+/// hybrid run mode (1 time-driven, 0 event-driven). The names are those of kPictureFields.
+template <int D>
+ParticleFrame snapshotFrame(const World<D>& w, double time, const HaetEngine<D>* hybrid) {
+    const Particles<D>& p = w.particles;
+    const std::size_t n = p.size();
+    ParticleFrame fr;
+    fr.time = time;
+    fr.xyz.assign(3 * n, 0.0);
+    for (const auto& [name, comps, type] : {std::tuple{"radius", 1, VtkField::Float64},
+                                            {"velocity", 3, VtkField::Float64},
+                                            {"angular_velocity", 3, VtkField::Float64},
+                                            {"force", 3, VtkField::Float64},
+                                            {"material", 1, VtkField::Int32},
+                                            {"id", 1, VtkField::Int64}})
+        fr.add(name, comps, type);
+    if (hybrid) fr.add("mode", 1, VtkField::Int32);
+    // Every field added: the references stay valid.
+    FrameField &rad = fr.fields[0], &vel = fr.fields[1], &spin = fr.fields[2], &force = fr.fields[3],
+               &mat = fr.fields[4], &ids = fr.fields[5];
+    const bool forces = p.hasTdmState();
+    for (std::size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < D; ++k) {
+            fr.xyz[3 * i + k] = p.x[i][k];
+            vel.values[3 * i + k] = p.v[i][k];
+            if (forces) force.values[3 * i + k] = p.f[i][k];
+        }
+        if constexpr (D == 2)
+            spin.values[3 * i + 2] = p.w[i][0];
+        else
+            for (int k = 0; k < 3; ++k) spin.values[3 * i + k] = p.w[i][k];
+        rad.values[i] = p.radius[i];
+        ids.values[i] = static_cast<double>(p.id[i]);
+        mat.values[i] = p.material[i];
+    }
+    if (hybrid)  // 1: time-driven, 0: event-driven
+        for (std::size_t i = 0; i < n; ++i) fr.fields[6].values[i] = i < p.tdmCount() ? 1 : 0;
+    return fr;
+}
+
 template <int D>
 class SnapshotWriter {
 public:
@@ -283,39 +325,8 @@ public:
 
     void write(const World<D>& w, double time, const HaetEngine<D>* hybrid) {
         const Particles<D>& p = w.particles;
-        const std::size_t n = p.size();
-        std::vector<double> xyz(3 * n, 0.0), vel(3 * n, 0.0), spin(3 * n, 0.0), force(3 * n, 0.0), rad(n);
-        std::vector<std::int64_t> ids(n);
-        std::vector<std::int32_t> mat(n);
-        const bool forces = p.hasTdmState();  // a pure event-driven run has none: written as zero
-        for (std::size_t i = 0; i < n; ++i) {
-            for (int k = 0; k < D; ++k) {
-                xyz[3 * i + k] = p.x[i][k];
-                vel[3 * i + k] = p.v[i][k];
-                if (forces) force[3 * i + k] = p.f[i][k];
-            }
-            if constexpr (D == 2)
-                spin[3 * i + 2] = p.w[i][0];
-            else
-                for (int k = 0; k < 3; ++k) spin[3 * i + k] = p.w[i][k];
-            rad[i] = p.radius[i];
-            ids[i] = static_cast<std::int64_t>(p.id[i]);
-            mat[i] = p.material[i];
-        }
         const std::string name = fmt::format("particles_{:06d}.vtu", count_);
-        std::vector<VtkField> fields = {{"radius", 1, VtkField::Float64, rad.data()},
-                                        {"velocity", 3, VtkField::Float64, vel.data()},
-                                        {"angular_velocity", 3, VtkField::Float64, spin.data()},
-                                        {"force", 3, VtkField::Float64, force.data()},
-                                        {"material", 1, VtkField::Int32, mat.data()},
-                                        {"id", 1, VtkField::Int64, ids.data()}};
-        std::vector<std::int32_t> mode;
-        if (hybrid) {  // 1: time-driven, 0: event-driven
-            mode.resize(n);
-            for (std::size_t i = 0; i < n; ++i) mode[i] = i < p.tdmCount() ? 1 : 0;
-            fields.push_back({"mode", 1, VtkField::Int32, mode.data()});
-        }
-        writeVtuPoints(dir_ / name, n, xyz.data(), fields, time);
+        writeFrameVtu(dir_ / name, snapshotFrame(w, time, hybrid));
         pvd_.add(time, name);
         if (hybrid) writeZones(*hybrid, time);
         if constexpr (D == 2) {
@@ -364,43 +375,43 @@ private:
     int count_ = 0;
 };
 
-/// A picture of a 2D state: disks coloured by speed (blue slow, red fast), or in a hybrid run by mode (time-driven
-/// blue, event-driven orange, darker when slow); walls as lines.
-void writePicture(const World<2>& w, const std::filesystem::path& path, bool byMode) {
-    PngScene scene;
-    scene.lo = {w.domain.lo[0], w.domain.lo[1]};
-    scene.hi = {w.domain.hi[0], w.domain.hi[1]};
-    scene.widthPx = 900;
-    const Particles<2>& p = w.particles;
-    double vmax = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) vmax = std::max(vmax, norm(p.v[i]));
-    for (std::size_t i = 0; i < p.size(); ++i) {
-        const double s = vmax > 0 ? norm(p.v[i]) / vmax : 0;
-        std::uint32_t colour;
-        if (p.frozen(i)) {
-            colour = 0x606060u;
-        } else if (byMode) {
-            const double k = 0.55 + 0.45 * std::sqrt(s);
-            auto ch = [&](double c) { return static_cast<std::uint32_t>(std::clamp(c * k, 0.0, 255.0)); };
-            colour = i < p.tdmCount() ? (ch(40) << 16) | (ch(110) << 8) | ch(235)
-                                      : (ch(255) << 16) | (ch(150) << 8) | ch(20);
-        } else {
-            const auto r = static_cast<std::uint32_t>(60 + 195 * s), b = static_cast<std::uint32_t>(255 - 195 * s);
-            colour = (r << 16) | (90u << 8) | b;
-        }
-        if (p.isPolygon(i))
-            scene.polygons.push_back({polygon::worldOutline(p, i), colour});
-        else
-            scene.disks.push_back({p.x[i][0], p.x[i][1], p.radius[i], colour});
+/// The box of a run, as a picture frames it.
+template <int D>
+PictureBox pictureBox(const World<D>& w) {
+    PictureBox b;
+    b.dimension = D;
+    b.lo = {0, 0, 0}, b.hi = {0, 0, 0};
+    for (int k = 0; k < D; ++k) {
+        b.lo[k] = w.domain.lo[k];
+        b.hi[k] = w.domain.hi[k];
+        b.gravity[k] = w.domain.gravity[k];
     }
-    addWallLines(w, scene);
-    if (byMode)
-        scene.caption = fmt::format("t = {:.4g} s, {} particles: {} time-driven (blue), {} event-driven (orange)",
-                                    w.time, p.size(), p.tdmCount(), p.size() - p.tdmCount());
-    else
-        scene.caption =
-            fmt::format("t = {:.4g} s, {} particles (colour: speed, max {:.3g} m/s)", w.time, p.size(), vmax);
-    writePng(path, scene);
+    return b;
+}
+
+PictureOptions pictureOptions(const Scenario& sc) {
+    return {sc.output.colorBy, sc.output.colorRange, sc.output.view, sc.output.pictureWidth};
+}
+
+std::vector<std::string> materialNames(const Scenario& sc) {
+    std::vector<std::string> names;
+    for (const MaterialDef& m : sc.materials) names.push_back(m.name);
+    return names;
+}
+
+/// final.png: the last state, as the last snapshot holds it, drawn as [output] asks.
+template <int D>
+void writeFinalPicture(const Scenario& sc, const World<D>& w, const HaetEngine<D>* hybrid,
+                       const std::filesystem::path& path) {
+    PolygonOutlines polygons;
+    if constexpr (D == 2)
+        for (std::size_t i = 0; i < w.particles.size(); ++i)
+            if (w.particles.isPolygon(i)) {
+                polygons.id.push_back(static_cast<std::int64_t>(w.particles.id[i]));
+                polygons.outline.push_back(polygon::worldOutline(w.particles, i));
+            }
+    writeFramePicture(path, snapshotFrame(w, w.time, hybrid), wallShapes(w, w.time), pictureBox(w), pictureOptions(sc),
+                      materialNames(sc), &polygons);
 }
 
 /// One-line progress on a terminal: simulated time, steps/s, contacts, ETA.
@@ -488,6 +499,21 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         }
         j.add("method", eng->method());
         j.add("dimension", static_cast<std::int64_t>(D));
+        {  // what `haet render` needs besides the snapshots: the box, the materials' names, the picture's settings
+            const PictureBox box = pictureBox(world);
+            JsonObject d, pic;
+            d.add("lo", std::vector<double>(box.lo.begin(), box.lo.begin() + D));
+            d.add("hi", std::vector<double>(box.hi.begin(), box.hi.begin() + D));
+            d.add("gravity", std::vector<double>(box.gravity.begin(), box.gravity.begin() + D));
+            j.add("domain", d);
+            j.add("materials", materialNames(sc));
+            const PictureOptions po = pictureOptions(sc);
+            pic.add("color_by", po.colorBy);
+            if (po.range) pic.add("color_range", std::vector<double>(po.range->begin(), po.range->end()));
+            pic.add("view", std::vector<double>(po.view.begin(), po.view.end()));
+            pic.add("width", static_cast<std::int64_t>(po.widthPx));
+            j.add("picture", pic);
+        }
         j.add("status", status);
         j.add("n_particles", world.particles.size());
         j.add("contact_time", world.contact.contactTime);
@@ -586,7 +612,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     progress.finish();
     series.flush();
     writeRunJson(statusText);
-    if constexpr (D == 2) writePicture(world, dir / "final.png", eng->hybrid() != nullptr);
+    writeFinalPicture(sc, world, eng->hybrid(), dir / "final.png");
     if (!opt.quiet) {
         const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
         log << fmt::format("{} ({}): {} particles, simulated {:.4g} s in {:.2f} s wall time; outputs in {}\n", sc.name,

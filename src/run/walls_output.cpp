@@ -20,7 +20,9 @@ std::array<double, 3> xyz(const Vec<D>& v) {
     return a;
 }
 
-/// A plane as a square patch about the box centre's projection onto it (a thin quad in 2D).
+/// A plane as a square patch about the box centre's projection onto it (a thin quad in 2D). In 3D its half-side is
+/// half the box's diagonal, so that it covers the plane's section of the box whatever its tilt (the pictures clip it
+/// to the box).
 template <int D>
 WallQuad planeQuad(const World<D>& w, std::size_t q, double t) {
     const Vec<D> L = w.domain.length();
@@ -40,7 +42,7 @@ WallQuad planeQuad(const World<D>& w, std::size_t q, double t) {
     const double al = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     for (int k = 0; k < 3; ++k) a[k] /= al;
     const std::array<double, 3> b{n[1] * a[2] - n[2] * a[1], n[2] * a[0] - n[0] * a[2], n[0] * a[1] - n[1] * a[0]};
-    const double ha = 0.5 * size, hb = D == 2 ? 0.01 * size : 0.5 * size;
+    const double ha = D == 2 ? 0.5 * size : 0.5 * norm(L), hb = D == 2 ? 0.01 * size : ha;
     WallQuad wq;
     wq.id = wl.id;
     const double sa[4] = {-1, 1, 1, -1}, sb[4] = {-1, -1, 1, 1};
@@ -141,22 +143,6 @@ WallShapes wallShapes(const World<D>& w, double t) {
         }
     }
     return sh;
-}
-
-void addWallLines(const World<2>& w, PngScene& scene) {
-    for (const Wall<2>& wl : w.walls) {
-        const Vec<2> pt = wl.pointAt(w.time);
-        const Vec<2> t{{-wl.normal[1], wl.normal[0]}};
-        const double L = norm(w.domain.length());
-        scene.walls.push_back({pt[0] - t[0] * L, pt[1] - t[1] * L, pt[0] + t[0] * L, pt[1] + t[1] * L});
-    }
-    const WallShapes sh = wallShapes(w, w.time);
-    for (std::size_t c = 0; c + 1 < sh.lineFirst.size(); ++c) {
-        const auto& a = sh.points[static_cast<std::size_t>(sh.lineIndex[static_cast<std::size_t>(sh.lineFirst[c])])];
-        const auto& b =
-            sh.points[static_cast<std::size_t>(sh.lineIndex[static_cast<std::size_t>(sh.lineFirst[c]) + 1])];
-        scene.walls.push_back({a[0], a[1], b[0], b[1]});
-    }
 }
 
 template <int D>

@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "io/png.hpp"
 #include "io/vtk.hpp"
 #include "tdm/engine.hpp"
 #include "world/world.hpp"
@@ -17,9 +16,6 @@ namespace haet {
 /// segments, a cylinder or a disc as a tessellation, an arc as a polyline.
 template <int D>
 WallShapes wallShapes(const World<D>& w, double t);
-
-/// The walls of a 2D state as line segments for a picture.
-void addWallLines(const World<2>& w, PngScene& scene);
 
 /// The series columns of the named walls' loads: NAME_fx, NAME_fy[, NAME_fz], then the torque (2D: NAME_tz; 3D:
 /// NAME_tx, NAME_ty, NAME_tz) [N, N m].

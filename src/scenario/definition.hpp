@@ -217,10 +217,22 @@ struct InletDef {
     SourcePos pos;
 };
 
+/// The snapshot fields a picture may be coloured by (`[output] color_by`); a vector field also by its magnitude
+/// (the name alone) or one component (NAME_x, NAME_y, NAME_z). "mode" exists in hybrid runs only.
+inline constexpr std::array<const char*, 7> kPictureFields = {
+    "velocity", "angular_velocity", "force", "radius", "material", "id", "mode"};
+inline constexpr std::array<const char*, 3> kPictureVectorFields = {"velocity", "angular_velocity", "force"};
+
 struct OutputDef {
     std::string directory = "out";  ///< run directory (--out overrides)
     double seriesPeriod = 0;        ///< [s] between rows of series.csv; 0 = 1/100 of duration
     double snapshotPeriod = 0;      ///< [s] between snapshots; 0 = 1/20 of duration; < 0 = none
+    /// final.png: the field it is coloured by ("" = "mode" in a hybrid run, else "velocity"), the colour bar's
+    /// limits (none = the data's), the direction a 3D picture looks along, and the width of the view [px].
+    std::string colorBy;
+    std::optional<std::array<double, 2>> colorRange;
+    Vec3d view{0, 1, 0};
+    int pictureWidth = 900;
     SourcePos pos;
 };
 

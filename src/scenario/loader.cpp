@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/spheres.hpp"
 #include "scenario/checks.hpp"
 #include "scenario/flow_loader.hpp"
 #include "scenario/table_reader.hpp"
@@ -503,7 +504,8 @@ private:
 
     void readOutput(Scenario& s) {
         const TableReader r = child("output");
-        r.allowOnly({"directory", "series_period", "snapshot_period"});
+        r.allowOnly(
+            {"directory", "series_period", "snapshot_period", "color_by", "color_range", "view", "picture_width"});
         OutputDef& o = s.output;
         o.pos = r.tablePos();
         o.directory = r.string("directory").value_or(o.directory);
@@ -512,6 +514,57 @@ private:
         if (!(o.seriesPeriod >= 0)) r.fail("series_period", "must be >= 0");
         o.snapshotPeriod = r.number("snapshot_period").value_or(o.snapshotPeriod);
         checkOutputCounts(r, s);
+        readPicture(r, s);
+    }
+
+    /// The keys of final.png (docs/scenario.md, [output]).
+    void readPicture(const TableReader& r, Scenario& s) const {
+        OutputDef& o = s.output;
+        o.colorBy = r.string("color_by").value_or("");
+        if (r.has("color_by")) {
+            std::string base = o.colorBy;
+            const std::size_t n = base.size();
+            bool component = false;
+            if (n > 2 && base[n - 2] == '_' && base[n - 1] >= 'x' && base[n - 1] <= 'z') {
+                for (const char* v : kPictureVectorFields)
+                    if (base.substr(0, n - 2) == v) component = true;
+                if (component) base = base.substr(0, n - 2);
+            }
+            std::string known;
+            bool found = false;
+            for (const char* f : kPictureFields) {
+                known += std::string(known.empty() ? "" : ", ") + "\"" + f + "\"";
+                found = found || base == f;
+            }
+            if (!found)
+                r.fail("color_by", "unknown field \"" + o.colorBy + "\"; one of " + known +
+                                       ", or a component of a vector field (\"velocity_z\")");
+            if (base == "mode" && s.method != Method::Haet)
+                r.fail("color_by", "\"mode\" needs method = \"haet\" (only the hybrid has two modes)");
+        }
+        if (r.has("color_range")) {
+            const Vec3d v = *r.vector("color_range", 2);
+            if (!(v[1] > v[0])) r.fail("color_range", "expected [lo, hi] with hi > lo");
+            if (o.colorBy == "mode" || o.colorBy == "material")
+                r.fail("color_range", "a categorical colouring (\"" + o.colorBy + "\") has no colour bar");
+            o.colorRange = std::array<double, 2>{v[0], v[1]};
+        }
+        if (r.has("view")) {
+            if (dim_ != 3) r.fail("view", "only for dimension = 3 (a 2D picture shows the plane)");
+            if (const toml::node* n = r.table().get("view"); n && n->is_string()) {
+                const auto v = axisView(*r.string("view"));
+                if (!v) r.fail("view", "expected \"x\", \"y\", \"z\", \"-x\", \"-y\", \"-z\" or [dx, dy, dz]");
+                o.view = *v;
+            } else {
+                o.view = *r.vector("view", 3);
+                if (!(o.view[0] * o.view[0] + o.view[1] * o.view[1] + o.view[2] * o.view[2] > 0))
+                    r.fail("view", "the direction must not be zero");
+            }
+        }
+        if (const auto w = r.integer("picture_width")) {
+            if (*w < 64 || *w > 4096) r.fail("picture_width", "must be 64 to 4096 px");
+            o.pictureWidth = static_cast<int>(*w);
+        }
     }
 
     /// A period that would write more rows or snapshots than a run can keep (series.csv is held in memory and
