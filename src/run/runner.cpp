@@ -18,11 +18,13 @@
 #include "edm/engine.hpp"
 #include "haet/engine.hpp"
 #include "io/atomic_file.hpp"
+#include "io/checkpoint.hpp"
 #include "io/json.hpp"
 #include "io/png.hpp"
 #include "io/series.hpp"
 #include "io/vtk.hpp"
 #include "polygon/output.hpp"
+#include "run/checkpoint.hpp"
 #include "run/flow.hpp"
 #include "run/run_dir.hpp"
 #include "run/schedule.hpp"
@@ -30,6 +32,7 @@
 #include "run/walls_output.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
+#include "world/state.hpp"
 
 namespace haet {
 namespace {
@@ -93,6 +96,12 @@ public:
     virtual const HaetEngine<D>* hybrid() const { return nullptr; }
     /// The time-driven step [s]; 0 for a pure event-driven run (the outlets' cadence, docs/physics.md K.2).
     virtual double stepTime() const = 0;
+    /// Whether the engine's state can be checkpointed and resumed (saveState, loadState).
+    virtual bool restartable() const { return false; }
+    /// The engine's state beyond the World's, at a time the loop stands at (after synchronise()).
+    virtual void saveState(ByteWriter&) const {}
+    /// Takes the checkpoint's state, in a driver made on the World loaded from it (loadWorld).
+    virtual void loadState(const CheckpointFile&) {}
 };
 
 template <int D>
@@ -129,6 +138,15 @@ public:
     void synchronise() override {}
     void remove(const std::vector<std::uint32_t>& which) override { removeTimeDriven(w_, eng_, which); }
     void added(std::size_t first) override { addTimeDriven(w_, eng_, first); }
+    bool restartable() const override { return true; }
+    void saveState(ByteWriter& out) const override { eng_.saveState(out); }
+    void loadState(const CheckpointFile& f) override {
+        // The engine's construction sorted the particles and computed forces: the saved store replaces that.
+        ByteReader world = f.section("WRLD");
+        loadWorld(world, w_);
+        ByteReader in = f.section("ENGN");
+        eng_.loadState(in);
+    }
 
 private:
     World<D>& w_;
@@ -334,6 +352,29 @@ public:
         ++count_;
     }
 
+    /// The snapshot count and the collections' entries, for a checkpoint.
+    void saveState(ByteWriter& out) const {
+        out.put<std::int64_t>(count_);
+        savePvd(out, pvd_);
+        savePvd(out, walls_);
+        savePvd(out, zones_);
+        out.put<std::uint8_t>(polys_.has_value());
+        if (polys_) savePvd(out, *polys_);
+    }
+    /// A resumed run's: the collections as they were at the checkpoint (their files rewritten); the snapshots the
+    /// stopped run wrote after it are written again, under the same names.
+    void loadState(ByteReader& in) {
+        count_ = static_cast<int>(in.get<std::int64_t>());
+        if (count_ < 0) in.fail("a negative snapshot count");
+        loadPvd(in, pvd_);
+        loadPvd(in, walls_);
+        loadPvd(in, zones_);
+        if (in.get<std::uint8_t>()) {
+            if (!polys_) polys_.emplace(dir_ / "polygons.pvd");
+            loadPvd(in, *polys_);
+        }
+    }
+
 private:
     /// Zone labels as an image: label 0 event-driven, 1 time-driven (buffer), 2 dense; smoothed fraction phi.
     void writeZones(const HaetEngine<D>& h, double time) {
@@ -434,20 +475,41 @@ private:
 template <int D>
 RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
     const auto t0 = Clock::now();
-    const std::filesystem::path dir = opt.outDir.empty() ? std::filesystem::path(sc.output.directory) : opt.outDir;
+    const std::filesystem::path dir = !opt.resumeDir.empty() ? opt.resumeDir
+                                      : opt.outDir.empty()   ? std::filesystem::path(sc.output.directory)
+                                                             : opt.outDir;
 
+    // A resumed run starts from the newest whole checkpoint of its directory: the World built from the scenario
+    // (box, walls, contact table) takes the saved particles, the engine is made on them and takes its own state.
+    std::optional<ResumePoint> resume;
+    if (!opt.resumeDir.empty()) resume = findCheckpoint(dir, sc, log);
     World<D> world = buildWorld<D>(sc);
+    if (resume) {
+        ByteReader in = resume->file.section("WRLD");
+        loadWorld(in, world);
+        in.expectEnd();
+    }
     StopSignals signals;
     std::unique_ptr<Driver<D>> eng = makeDriver<D>(sc, world, signals.flag());
+    if (resume) {
+        if (!eng->restartable())
+            throw std::invalid_argument(std::string("--resume: runs of method \"") + eng->method() +
+                                        "\" cannot be resumed yet");
+        eng->loadState(resume->file);
+    }
     const RunPlan plan = planRun(sc, eng->dt(), world.contact.contactTime);
     for (const auto& [key, what] : plan.warnings) log << "warning: " << key << ": " << what << "\n";
 
-    prepareRunDirectory(dir);
+    if (!resume) prepareRunDirectory(dir);
     std::vector<std::string> columns = {
         "time",         "step",        "kinetic_energy", "rotational_energy", "potential_energy", "elastic_energy",
         "total_energy", "n_particles", "n_contacts",     "max_overlap_ratio", "pressure"};
     for (auto& c : eng->extraColumns()) columns.push_back(c);
     Flow<D> flow(sc, world, eng->stepTime());
+    if (resume) {
+        ByteReader in = resume->file.section("FLOW");
+        flow.loadState(in);
+    }
     for (auto& c : flow.columns()) columns.push_back(c);
     double lastRowTime = world.time;
     auto rowValues = [&](double stamp) {
@@ -487,6 +549,10 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
             j.add("overrides", o);
         }
         j.add("method", eng->method());
+        if (resume) {  // the checkpoint this run went on from
+            j.add("resumed_from", resume->path.filename().string());
+            j.add("resumed_at", resume->file.header.time);
+        }
         j.add("dimension", static_cast<std::int64_t>(D));
         j.add("status", status);
         j.add("n_particles", world.particles.size());
@@ -506,6 +572,8 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         j.add("peak_rss_bytes", peakRssBytes());
         writeFileAtomic(dir / "run.json", j.dump() + "\n");
     };
+    // A resumed run's series.csv as the stopped run left it, read before it is rewritten.
+    std::string savedSeries = resume ? readFileText(dir / "series.csv") : std::string();
     // A run killed before its end (kill -9, a node lost) leaves run.json saying so; it also proves the directory
     // writable before any time is spent.
     writeRunJson("running");
@@ -516,12 +584,33 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                      (opt.progress == ProgressDisplay::Auto && !opt.quiet && isatty(STDERR_FILENO));
     Progress progress(tty, sc.duration);
     const double eps = eng->timeTolerance();
-    OutputClock rows(plan.seriesPeriod), shots(plan.snapshotPeriod);
+    OutputClock rows(plan.seriesPeriod), shots(plan.snapshotPeriod), ckpts(sc.output.checkpointPeriod);
     // The engine is called in the same pieces whether or not the progress line shows (an event-driven engine's
     // state depends on where its calls end): up to every output time and every 1/500 of the run, at which the
     // progress line may update (at most every 200 ms).
     OutputClock chunks(sc.duration / 500);
     double lastRow = -1, lastShot = -1;  // engine times of the last row and snapshot written
+    double lastCheckpoint = -1;          // engine time of the last checkpoint
+    std::uint64_t sequence = 0;          // of the last checkpoint written
+    if (resume) {
+        // The outputs as they were when the checkpoint was written: series.csv up to its rows (a stopped run's
+        // last-state row after it is not the schedule's), the collections' entries; the clocks from the times of
+        // the last outputs, so that periods changed on resume take effect from here.
+        ByteReader in = resume->file.section("RUN ");
+        sequence = in.get<std::uint64_t>();
+        lastRow = in.get<double>();
+        lastShot = in.get<double>();
+        lastRowTime = in.get<double>();
+        const SeriesMark mark = loadSeriesMark(in);
+        snaps.loadState(in);
+        in.expectEnd();
+        series.resume(seriesAtCheckpoint(std::move(savedSeries), mark, series.path(), resume->path), mark.rows);
+        if (lastRow >= 0) rows.pass(lastRow, eps);
+        if (lastShot >= 0) shots.pass(lastShot, eps);
+        ckpts.pass(world.time, eps);
+        lastCheckpoint = world.time;
+        log << "resuming from " << resume->path.string() << " at t = " << world.time << " s\n";
+    }
     auto row = [&](double stamp) {
         eng->synchronise();
         series.row(rowValues(stamp));
@@ -532,6 +621,46 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         snaps.write(world, stamp, eng->hybrid());
         series.flush();
         lastShot = world.time;
+    };
+    // A checkpoint: the whole state at world.time and the outputs written so far (series.csv flushed first, so
+    // that the file on disk always holds at least the rows a checkpoint counts).
+    const bool checkpoints = eng->restartable();
+    if (!checkpoints && sc.output.checkpointPeriod > 0)
+        log << "warning: output.checkpoint_period: runs of method \"" << eng->method()
+            << "\" write no checkpoints yet\n";
+    auto checkpoint = [&] {
+        if (!checkpoints) return;
+        eng->synchronise();
+        series.flush();
+        ByteWriter body;
+        body.beginSection("SCEN");
+        body.putString(sc.stateKeys);
+        body.endSection();
+        body.beginSection("WRLD");
+        saveWorld(body, world);
+        body.endSection();
+        body.beginSection("ENGN");
+        eng->saveState(body);
+        body.endSection();
+        body.beginSection("FLOW");
+        flow.saveState(body);
+        body.endSection();
+        body.beginSection("RUN ");
+        body.put<std::uint64_t>(sequence + 1);
+        body.put<double>(lastRow);
+        body.put<double>(lastShot);
+        body.put<double>(lastRowTime);
+        saveSeriesMark(body, series);
+        snaps.saveState(body);
+        body.endSection();
+        CheckpointHeader h;
+        h.dimension = D;
+        h.method = eng->method();
+        h.scenarioHash = sc.stateHash;
+        h.time = world.time;
+        h.sequence = ++sequence;
+        writeCheckpoint(dir, sequence, encodeCheckpoint(h, body.bytes()));
+        lastCheckpoint = world.time;
     };
     RunStatus status = RunStatus::Completed;
     std::string statusText = "completed";
@@ -545,9 +674,13 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                 shot(OutputClock::stamp(world.time, shots.next()));
                 shots.pass(world.time, eps);
             }
+            if (ckpts.due(world.time, eps)) {
+                if (lastCheckpoint != world.time) checkpoint();
+                ckpts.pass(world.time, eps);
+            }
             if (world.time + eps >= sc.duration || signals.requested()) break;
             // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
-            const double target = std::min({sc.duration, rows.next(), shots.next(), flow.nextTime()});
+            const double target = std::min({sc.duration, rows.next(), shots.next(), ckpts.next(), flow.nextTime()});
             while (chunks.due(world.time, eps)) chunks.pass(world.time, eps);
             eng->advanceTo(chunks.next() < target - eps ? chunks.next() : target);
             if (world.time + eps >= flow.nextTime()) flow.act(world, *eng, eps);
@@ -574,9 +707,11 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         log << (signals.signal() == SIGINT ? "\nSIGINT" : "\nSIGTERM") << ": stopped at t = " << world.time
             << " s; writing the last state\n";
     }
-    // The last state, always: a row and a snapshot at the time the run ended, unless the schedule just wrote them.
-    // (A checkpoint of the whole state, for a restart, would be written here too, before run.json closes the run.)
+    // The last state, always: a checkpoint (before the last row and snapshot, which are not the schedule's: a
+    // resumed run drops them), then a row and a snapshot at the time the run ended, unless the schedule just wrote
+    // them. A blown-up state is not checkpointed: the last checkpoint stays the newest.
     try {
+        if (status != RunStatus::BlewUp && lastCheckpoint != world.time) checkpoint();
         if (lastRow != world.time) row(OutputClock::stamp(world.time, sc.duration));
         if (lastShot != world.time) shot(OutputClock::stamp(world.time, sc.duration));
     } catch (const SimulationError& e) {  // a blown-up state the engine cannot bring to one time

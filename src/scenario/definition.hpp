@@ -218,6 +218,7 @@ struct OutputDef {
     std::string directory = "out";  ///< run directory (--out overrides)
     double seriesPeriod = 0;        ///< [s] between rows of series.csv; 0 = 1/100 of duration
     double snapshotPeriod = 0;      ///< [s] between snapshots; 0 = 1/20 of duration; < 0 = none
+    double checkpointPeriod = 0;    ///< [s] between checkpoints; 0 = none but the one at the end (and at a stop)
     SourcePos pos;
 };
 
@@ -243,7 +244,11 @@ struct Scenario {
     std::vector<OutletDef> outlets;
     std::vector<InletDef> inlets;
     OutputDef output;
-    std::string hash;                    ///< hash of the file contents (hex)
+    std::string hash;  ///< hash of the file contents (hex)
+    /// Every key a resume may not change (docs/scenario.md, "Resuming"), one "key = value" line each, after the
+    /// overrides, in key order: what a checkpoint records of its scenario, and stateHash its hash (hex).
+    std::string stateKeys;
+    std::string stateHash;
     std::vector<std::string> overrides;  ///< command-line overrides applied to the file, "KEY=VALUE" (loader.hpp)
 };
 
