@@ -98,11 +98,24 @@ public:
     virtual double stepTime() const = 0;
     /// Whether the engine's state can be checkpointed and resumed (saveState, loadState).
     virtual bool restartable() const { return false; }
-    /// The engine's state beyond the World's, at a time the loop stands at (after synchronise()).
+    /// The engine's state beyond the World's, between calls of advanceTo (after exposeState()).
     virtual void saveState(ByteWriter&) const {}
     /// Takes the checkpoint's state, in a driver made on the World loaded from it (loadWorld).
     virtual void loadState(const CheckpointFile&) {}
+    /// Before a checkpoint: the World as it must be saved, without changing what the engine computes next (an
+    /// event-driven engine holding the positions gives them back as they are, unsynchronised).
+    virtual void exposeState() {}
 };
+
+/// The driver's loadState for one engine: the World's particles again (making the engine may have sorted them or
+/// wrapped them into the box), then the engine's own state.
+template <int D, class Engine>
+void loadEngineState(const CheckpointFile& f, World<D>& w, Engine& eng) {
+    ByteReader world = f.section("WRLD");
+    loadWorld(world, w);
+    ByteReader in = f.section("ENGN");
+    eng.loadState(in);
+}
 
 template <int D>
 class TdmDriver final : public Driver<D> {
@@ -140,13 +153,7 @@ public:
     void added(std::size_t first) override { addTimeDriven(w_, eng_, first); }
     bool restartable() const override { return true; }
     void saveState(ByteWriter& out) const override { eng_.saveState(out); }
-    void loadState(const CheckpointFile& f) override {
-        // The engine's construction sorted the particles and computed forces: the saved store replaces that.
-        ByteReader world = f.section("WRLD");
-        loadWorld(world, w_);
-        ByteReader in = f.section("ENGN");
-        eng_.loadState(in);
-    }
+    void loadState(const CheckpointFile& f) override { loadEngineState(f, w_, eng_); }
 
 private:
     World<D>& w_;
@@ -191,6 +198,10 @@ public:
         eng_.reset();
     }
     void added(std::size_t) override { eng_.reset(); }
+    bool restartable() const override { return eng_.restartable(); }
+    void exposeState() override { eng_.exposeHeldState(); }
+    void saveState(ByteWriter& out) const override { eng_.saveState(out); }
+    void loadState(const CheckpointFile& f) override { loadEngineState(f, w_, eng_); }
 
 private:
     World<D>& w_;
@@ -630,7 +641,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
             << "\" write no checkpoints yet\n";
     auto checkpoint = [&] {
         if (!checkpoints) return;
-        eng->synchronise();
+        eng->exposeState();
         series.flush();
         ByteWriter body;
         body.beginSection("SCEN");

@@ -43,8 +43,6 @@ void loadWorld(ByteReader& in, World<D>& w) {
     const auto nTdm = in.get<std::uint64_t>();
     const bool tdmState = in.get<std::uint8_t>() != 0;
     if (nTdm > n && nTdm != std::uint64_t(-1)) in.fail("more time-driven particles than particles");
-    if (tdmState != p.hasTdmState())
-        in.fail(tdmState ? "forces saved for a run that keeps none" : "no forces saved for a run that keeps them");
     if (n > in.rest().size() / (2 * sizeof(Vec<D>))) in.fail("more particles than the bytes left hold");
     Particles<D> q;
     if (!tdmState) q.dropTdmState();

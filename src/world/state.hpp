@@ -14,7 +14,8 @@ void saveWorld(ByteWriter& out, const World<D>& w);
 
 /// Replaces world.time and the particle store of a World built from the same scenario with the saved ones. Throws
 /// CheckpointError (Corrupt) when the saved arrays do not fit together (sizes, indices into the shape table,
-/// materials outside the contact table) or do not fit the World (which keeps forces or not, as its method does).
+/// materials outside the contact table). The store keeps forces and torques as the saved one did (a pure
+/// event-driven run's has none).
 template <int D>
 void loadWorld(ByteReader& in, World<D>& w);
 
