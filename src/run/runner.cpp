@@ -25,7 +25,9 @@
 #include "io/vtk.hpp"
 #include "polygon/output.hpp"
 #include "run/checkpoint.hpp"
+#include "run/export.hpp"
 #include "run/flow.hpp"
+#include "run/progress.hpp"
 #include "run/run_dir.hpp"
 #include "run/schedule.hpp"
 #include "run/stop.hpp"
@@ -455,34 +457,6 @@ void writePicture(const World<2>& w, const std::filesystem::path& path, bool byM
     writePng(path, scene);
 }
 
-/// One-line progress on a terminal: simulated time, steps/s, contacts, ETA.
-class Progress {
-public:
-    Progress(bool enabled, double duration) : on_(enabled), duration_(duration), start_(Clock::now()) {}
-    void update(double t, std::uint64_t steps, std::size_t contacts, bool force = false) {
-        if (!on_) return;
-        const auto now = Clock::now();
-        if (!force && now - last_ < std::chrono::milliseconds(200)) return;
-        last_ = now;
-        const double el = std::chrono::duration<double>(now - start_).count();
-        const double frac = std::clamp(t / duration_, 0.0, 1.0);
-        const int width = 30, filled = static_cast<int>(frac * width);
-        const double eta = frac > 0 ? el * (1 - frac) / frac : 0;
-        std::fprintf(stderr, "\r[%s%s] t = %.4g s  %.3g steps/s  %zu contacts  ETA %.0f s   ",
-                     std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), t,
-                     el > 0 ? steps / el : 0.0, contacts, eta);
-        std::fflush(stderr);
-    }
-    void finish() {
-        if (on_) std::fprintf(stderr, "\n");
-    }
-
-private:
-    bool on_;
-    double duration_;
-    Clock::time_point start_, last_{};
-};
-
 template <int D>
 RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
     const auto t0 = Clock::now();
@@ -731,6 +705,11 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     progress.update(world.time, eng->steps(), eng->contacts(), true);
     progress.finish();
     series.flush();
+    // The state for a next stage (run/export.hpp): disks and spheres, unless the run blew up.
+    if (status != RunStatus::BlewUp && !world.particles.hasPolygons() && world.particles.hasMotion()) {
+        writeStateCsv(dir / "final.csv", world, sc.materials);
+        writeLammpsData(dir / "final.data", world, sc.materials);
+    }
     writeRunJson(statusText);
     if constexpr (D == 2) writePicture(world, dir / "final.png", eng->hybrid() != nullptr);
     if (!opt.quiet) {
