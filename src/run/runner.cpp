@@ -521,6 +521,10 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         return row;
     };
 
+    struct {
+        std::uint64_t written = 0, bytes = 0;
+        double seconds = 0;  // wall time spent making and writing them [s]
+    } ckptBook;
     auto writeRunJson = [&](const std::string& status) {
         const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
         JsonObject j;
@@ -550,6 +554,13 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
             JsonObject w;
             for (const auto& [key, what] : plan.warnings) w.add(key, what);
             j.add("warnings", w);
+        }
+        if (ckptBook.written > 0) {  // what the checkpoints of this run cost: their count, last size, time
+            JsonObject c;
+            c.add("written", ckptBook.written);
+            c.add("last_bytes", ckptBook.bytes);
+            c.add("seconds", ckptBook.seconds);
+            j.add("checkpoints", c);
         }
         j.add("wall_time", wall);
         j.add("particle_steps_per_second", wall > 0 ? double(eng->steps()) * world.particles.size() / wall : 0.0);
@@ -615,6 +626,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
             << "\" write no checkpoints yet\n";
     auto checkpoint = [&] {
         if (!checkpoints) return;
+        const auto start = Clock::now();
         eng->exposeState();
         series.flush();
         ByteWriter body;
@@ -644,8 +656,12 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         h.scenarioHash = sc.stateHash;
         h.time = world.time;
         h.sequence = ++sequence;
-        writeCheckpoint(dir, sequence, encodeCheckpoint(h, body.bytes()));
+        const std::string file = encodeCheckpoint(h, body.bytes());
+        writeCheckpoint(dir, sequence, file);
         lastCheckpoint = world.time;
+        ckptBook.written += 1;
+        ckptBook.bytes = file.size();
+        ckptBook.seconds += std::chrono::duration<double>(Clock::now() - start).count();
     };
     RunStatus status = RunStatus::Completed;
     std::string statusText = "completed";
