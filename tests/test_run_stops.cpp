@@ -49,12 +49,13 @@ TEST_F(RunStops, SignalsWriteTheLastStateAndExit130Or143) {
     const std::vector<std::pair<std::string, std::vector<std::string>>> runs = {
         {"drop3d_tiny.toml", {"duration=100", "output.series_period=2e-4", "output.snapshot_period=1e-3"}},
         {"dilute_gas3d.toml",
-         {"duration=1000", "insert[1].count=300", "output.series_period=1e-3", "output.snapshot_period=5e-3"}},
+         {"duration=400", "insert[1].count=300", "output.series_period=1e-3", "output.snapshot_period=5e-3"}},
         {"haet_demo.toml", {"duration=100", "output.series_period=2e-4", "output.snapshot_period=1e-3"}}};
     for (const auto& [scene, sets] : runs)
         for (const int sig : {SIGTERM, SIGINT}) {
             SCOPED_TRACE(scene + (sig == SIGTERM ? " SIGTERM" : " SIGINT"));
-            const fs::path out = dir_ / ("run_" + std::to_string(sig));
+            // A directory per run: an earlier run's series.csv would end the wait before this run handles signals.
+            const fs::path out = dir_ / (scene + "_" + std::to_string(sig));
             const pid_t pid = start(scene, sets, out);
             waitForRows(out, 4);
             kill(pid, sig);

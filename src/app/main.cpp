@@ -13,6 +13,7 @@
 
 #include "core/version.hpp"
 #include "io/atomic_file.hpp"
+#include "io/checkpoint.hpp"
 #include "io/png.hpp"
 #include "io/table.hpp"
 #include "run/render.hpp"
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", std::string("haet ") + haet::kVersion);
     app.require_subcommand(1);
 
-    std::string runFile, outDir;
+    std::string runFile, outDir, resumeDir;
     std::vector<std::string> sets;  // --set KEY=VALUE of `run` or `check`, in order
     int threads = 0;
     bool quiet = false, progress = false;
@@ -56,6 +57,8 @@ int main(int argc, char** argv) {
     run->add_option("--out", outDir, "output directory (default: [output] directory of the scenario)");
     run->add_option("--threads", threads, "number of threads (default: all cores)")->check(CLI::NonNegativeNumber);
     run->add_flag("--quiet,-q", quiet, "no progress bar or summary");
+    run->add_option("--resume", resumeDir,
+                    "go on from the newest whole checkpoint of this run directory (the outputs go there too)");
     run->add_flag("--progress", progress, "show the progress line even when stderr is not a terminal");
     // One value per --set, so that the scenario may follow it.
     run->add_option("--set", sets, setHelp)
@@ -111,9 +114,16 @@ int main(int argc, char** argv) {
     try {
         if (*run) {
             const haet::Scenario sc = haet::loadScenario(runFile, sets);
+            if (!resumeDir.empty() && !outDir.empty() &&
+                std::filesystem::weakly_canonical(outDir) != std::filesystem::weakly_canonical(resumeDir)) {
+                std::cerr << "error: --out " << outDir << " and --resume " << resumeDir
+                          << ": a resumed run writes into the directory it resumes\n";
+                return 2;
+            }
             haet::RunOptions opt{outDir, threads, quiet,
                                  progress ? haet::ProgressDisplay::On
-                                          : (quiet ? haet::ProgressDisplay::Off : haet::ProgressDisplay::Auto)};
+                                          : (quiet ? haet::ProgressDisplay::Off : haet::ProgressDisplay::Auto),
+                                 resumeDir};
             return static_cast<int>(haet::runScenario(sc, opt, std::cerr));
         }
         if (*render) {
@@ -174,6 +184,9 @@ int main(int argc, char** argv) {
         return 0;
     } catch (const haet::ScenarioError& e) {
         std::cerr << "error: " << e.what() << "\n";
+        return 2;
+    } catch (const haet::CheckpointError& e) {  // --resume: corrupt, truncated, a later format, another scenario
+        std::cerr << "error: --resume: " << e.what() << "\n";
         return 2;
     } catch (const std::invalid_argument& e) {
         std::cerr << "error: " << e.what() << "\n";

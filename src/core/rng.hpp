@@ -70,6 +70,29 @@ public:
     /// Position in the sequence (number of 128-bit blocks consumed so far).
     std::uint64_t counter() const { return counter_; }
 
+    /// Where the sequence stands, whole (a checkpoint's copy): a generator of the same seed and stream set to it
+    /// draws what this one would. No padding, so that its bytes are its value.
+    struct Position {
+        std::uint64_t counter = 0;
+        std::array<std::uint64_t, 2> block{};
+        std::uint64_t have = 0;  ///< values of block not served yet (0, 1 or 2)
+        std::uint64_t haveNormal = 0;
+        double spareNormal = 0;
+    };
+    Position position() const {
+        return {counter_, block_, static_cast<std::uint64_t>(have_), haveNormal_ ? 1u : 0u, spareNormal_};
+    }
+    /// Returns false (and changes nothing) for a position no generator can be in.
+    bool setPosition(const Position& p) {
+        if (p.have > 2 || p.haveNormal > 1) return false;
+        counter_ = p.counter;
+        block_ = p.block;
+        have_ = static_cast<int>(p.have);
+        haveNormal_ = p.haveNormal != 0;
+        spareNormal_ = p.spareNormal;
+        return true;
+    }
+
 private:
     void refill() {
         const auto out = philox4x32({std::uint32_t(counter_), std::uint32_t(counter_ >> 32), std::uint32_t(stream_),

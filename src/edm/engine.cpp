@@ -585,8 +585,10 @@ double EdmEngine<D>::advanceEvents(double t) {
         putBackState();
         throw;
     }
-    // Particles diffuse away from their sorted neighbours; re-sort after ~20 events per particle.
-    if (events_ - sortedAt_ > 20 * static_cast<std::uint64_t>(std::max<std::size_t>(nLive_, 1))) resort();
+    // Particles diffuse away from their sorted neighbours; re-sort after ~20 events per particle. Not after a stop:
+    // the run would not have sorted there, and a resumed one goes on from the state as it is (a checkpoint).
+    if (reached == t && events_ - sortedAt_ > 20 * static_cast<std::uint64_t>(std::max<std::size_t>(nLive_, 1)))
+        resort();
     return reached;
 }
 

@@ -30,6 +30,7 @@
 #include "edm/shells.hpp"
 #include "edm/slots.hpp"
 #include "edm/tc_model.hpp"
+#include "io/checkpoint.hpp"
 #include "world/world.hpp"
 
 namespace haet {
@@ -187,6 +188,23 @@ public:
     std::size_t memoryBytes() const;  ///< heap memory of the engine's own arrays [bytes]
     /// The mesh elements the engine predicts (its static meshes), binned into its cells.
     const edm::MeshWalls<D>& meshWalls() const { return mesh_; }
+
+    // ---- checkpoints (edm/state.cpp; ARCHITECTURE.md, "Checkpoints") ----
+    /// Whether saveState can hold the whole state: not with neighbour shells, whose lists it does not save.
+    bool restartable() const { return !shells_.on() && !s_.reference; }
+    /// The slots as they are (each particle at its own clock: nothing is advanced), their pending events, the TC
+    /// model's clocks, the free slots and the counters. Between calls of advanceEvents; the grid's cell lists and the
+    /// queue are made again from the slots on loading, which orders nothing differently (pops go by time, then slot;
+    /// a scan's best by time, then code, whatever the order of the cells' lists).
+    void saveState(ByteWriter& out) const;
+    /// Replaces the state with a saved one, in an engine made for the same scenario on the World loaded from the
+    /// same checkpoint. Throws CheckpointError (Corrupt) for a state that does not fit (sizes, slot, cell, wall and
+    /// World indices).
+    void loadState(ByteReader& in);
+    /// With EdmSettings::holdState between calls of advanceEvents: gives the World its positions, velocities and radii
+    /// as the slots hold them (each at its own clock, not advanced), so that it can be saved; changes nothing of the
+    /// engine's state.
+    void exposeHeldState();
 
 private:
     using Sl = edm::Slots<D>;

@@ -52,6 +52,9 @@ public:
     /// (n.g) [m/s]: |n.g| t_c when gravity pushes into the obstacle, else 0.
     double restSpeed(double gAcc) const { return (on() && gAcc < 0) ? -gAcc * tc_ : 0; }
     std::size_t memoryBytes() const { return last_.capacity() * sizeof(double); }
+    /// Each slot's time of its last collision (empty when off): a checkpoint's copy, and back.
+    const std::vector<double>& lastCollisions() const { return last_; }
+    void setLastCollisions(std::vector<double> t) { last_ = std::move(t); }
 
 private:
     double tc_ = 0;

@@ -59,6 +59,17 @@ void SeriesWriter::row(const std::vector<std::optional<double>>& values) {
     if (std::chrono::steady_clock::now() - lastFlush_ >= autoFlush_) flush();
 }
 
+void SeriesWriter::resume(std::string text, std::size_t rows) {
+    const std::string header = text_.substr(0, text_.find('\n') + 1);
+    if (text.compare(0, header.size(), header) != 0)
+        throw std::invalid_argument(path_.string() + ": the saved rows have another header than this run's");
+    if (text.empty() || text.back() != '\n')
+        throw std::invalid_argument(path_.string() + ": the saved rows do not end with a whole row");
+    text_ = std::move(text);
+    rows_ = rows;
+    flush();
+}
+
 void SeriesWriter::flush() {
     writeFileAtomic(path_, text_);
     lastFlush_ = std::chrono::steady_clock::now();

@@ -32,6 +32,11 @@ public:
     /// Rewrites the file with every row so far. Throws IoError.
     void flush();
 
+    /// Replaces the rows with those of `text` (header included, as text() had it; a resumed run's series up to its
+    /// checkpoint) and rewrites the file. Throws std::invalid_argument unless text starts with this series' header
+    /// and ends a row, IoError if the file cannot be written.
+    void resume(std::string text, std::size_t rows);
+
     const std::filesystem::path& path() const { return path_; }
     const std::string& text() const { return text_; }
     std::size_t rows() const { return rows_; }

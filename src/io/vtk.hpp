@@ -99,12 +99,19 @@ public:
     const std::filesystem::path& path() const { return path_; }
     std::size_t size() const { return entries_.size(); }
 
-private:
     struct Entry {
         double time;
         std::string file;
         int part;
     };
+    const std::vector<Entry>& entries() const { return entries_; }
+    /// Replaces the entries (a resumed run's, from its checkpoint) and rewrites the file. Throws IoError.
+    void assign(std::vector<Entry> entries) {
+        entries_ = std::move(entries);
+        rewrite();
+    }
+
+private:
     void rewrite() const;
 
     std::filesystem::path path_;

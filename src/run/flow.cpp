@@ -291,6 +291,108 @@ void describeFlows(const Scenario& sc, std::ostream& out) {
             o.remove ? "" : ", a counter (particles stay)", o.interval);
 }
 
+namespace {
+
+template <int D>
+void putNew(ByteWriter& out, const NewParticle<D>& q) {
+    out.put(q.x);
+    out.put(q.v);
+    out.put(q.w);
+    out.put(q.radius);
+    out.put(q.density);
+    out.put(q.material);
+    out.put(q.flags);
+    out.put(q.image);
+    out.putVector(q.body);
+    out.put(q.orientation);
+}
+
+template <int D>
+NewParticle<D> getNew(ByteReader& in) {
+    NewParticle<D> q;
+    q.x = in.get<Vec<D>>();
+    q.v = in.get<Vec<D>>();
+    q.w = in.get<Ang<D>>();
+    q.radius = in.get<double>();
+    q.density = in.get<double>();
+    q.material = in.get<std::uint16_t>();
+    q.flags = in.get<std::uint8_t>();
+    q.image = in.get<std::array<std::int32_t, D>>();
+    in.getVector(q.body);
+    q.orientation = in.get<double>();
+    return q;
+}
+
+}  // namespace
+
+template <int D>
+void Flow<D>::saveState(ByteWriter& out) const {
+    out.put<double>(time_);
+    out.put<double>(rowTime_);
+    out.put<std::uint64_t>(nextId_);
+    out.put<std::uint64_t>(initial_);
+    out.put<double>(nextLazy_);
+    out.put<std::uint64_t>(inlets_.size());
+    for (const Inlet& in : inlets_) {
+        out.put(in.rng.position());
+        out.put<double>(in.next);
+        out.put<std::uint64_t>(in.pending.size());
+        for (const NewParticle<D>& q : in.pending) putNew(out, q);
+        out.put<std::uint8_t>(in.drawn.has_value());
+        if (in.drawn) putNew(out, *in.drawn);
+        out.put<std::uint64_t>(in.batches);
+        out.put<std::uint64_t>(in.drawnCount);
+        out.put<double>(in.drawnMass);
+        out.put<std::uint64_t>(in.in.particles);
+        out.put<double>(in.in.mass);
+    }
+    out.put<std::uint64_t>(outlets_.size());
+    for (const Outlet& o : outlets_) {
+        out.put<std::uint64_t>(o.out.particles);
+        out.put<double>(o.out.mass);
+        out.put<double>(o.massAtRow);
+        // A counter's ids, sorted: the same state gives the same bytes.
+        std::vector<std::uint64_t> seen(o.seen.begin(), o.seen.end());
+        std::sort(seen.begin(), seen.end());
+        out.putVector(seen);
+    }
+}
+
+template <int D>
+void Flow<D>::loadState(ByteReader& in) {
+    time_ = in.get<double>();
+    rowTime_ = in.get<double>();
+    nextId_ = in.get<std::uint64_t>();
+    initial_ = in.get<std::uint64_t>();
+    nextLazy_ = in.get<double>();
+    if (in.get<std::uint64_t>() != inlets_.size()) in.fail("another number of inlets than the scenario's");
+    for (Inlet& k : inlets_) {
+        if (!k.rng.setPosition(in.get<Rng::Position>())) in.fail("an inlet's random stream is in no possible place");
+        k.next = in.get<double>();
+        const auto pending = in.get<std::uint64_t>();
+        if (pending > in.rest().size() / sizeof(Vec<D>)) in.fail("more pending particles than the bytes left hold");
+        k.pending.clear();
+        for (std::uint64_t q = 0; q < pending; ++q) k.pending.push_back(getNew<D>(in));
+        k.drawn.reset();
+        if (in.get<std::uint8_t>()) k.drawn = getNew<D>(in);
+        k.batches = in.get<std::uint64_t>();
+        k.drawnCount = in.get<std::uint64_t>();
+        k.drawnMass = in.get<double>();
+        k.in.particles = in.get<std::uint64_t>();
+        k.in.mass = in.get<double>();
+    }
+    if (in.get<std::uint64_t>() != outlets_.size()) in.fail("another number of outlets than the scenario's");
+    for (Outlet& o : outlets_) {
+        o.out.particles = in.get<std::uint64_t>();
+        o.out.mass = in.get<double>();
+        o.massAtRow = in.get<double>();
+        std::vector<std::uint64_t> seen;
+        in.getVector(seen);
+        o.seen = std::unordered_set<std::uint64_t>(seen.begin(), seen.end());
+    }
+    in.expectEnd();
+}
+
 template class Flow<2>;
 template class Flow<3>;
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/rng.hpp"
+#include "io/checkpoint.hpp"
 #include "io/json.hpp"
 #include "scenario/definition.hpp"
 #include "scenario/insert.hpp"
@@ -62,6 +63,11 @@ public:
     std::vector<std::optional<double>> row(double time);
     /// run.json: "flows": the initial count and each inlet's and outlet's totals.
     void describe(JsonObject& j) const;
+
+    /// The books and the inlets' places in their random streams and schedules, for a checkpoint; load into a Flow
+    /// made from the same scenario. Throws CheckpointError (Corrupt) when the saved inlets and outlets do not fit.
+    void saveState(ByteWriter& out) const;
+    void loadState(ByteReader& in);
 
 private:
     struct Inlet {

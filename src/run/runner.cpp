@@ -18,19 +18,24 @@
 #include "edm/engine.hpp"
 #include "haet/engine.hpp"
 #include "io/atomic_file.hpp"
+#include "io/checkpoint.hpp"
 #include "io/frame.hpp"
 #include "io/json.hpp"
 #include "io/series.hpp"
 #include "io/vtk.hpp"
 #include "polygon/output.hpp"
+#include "run/checkpoint.hpp"
+#include "run/export.hpp"
 #include "run/flow.hpp"
 #include "run/picture.hpp"
+#include "run/progress.hpp"
 #include "run/run_dir.hpp"
 #include "run/schedule.hpp"
 #include "run/stop.hpp"
 #include "run/walls_output.hpp"
 #include "tdm/engine.hpp"
 #include "world/build.hpp"
+#include "world/state.hpp"
 
 namespace haet {
 namespace {
@@ -94,7 +99,26 @@ public:
     virtual const HaetEngine<D>* hybrid() const { return nullptr; }
     /// The time-driven step [s]; 0 for a pure event-driven run (the outlets' cadence, docs/physics.md K.2).
     virtual double stepTime() const = 0;
+    /// Whether the engine's state can be checkpointed and resumed (saveState, loadState).
+    virtual bool restartable() const { return false; }
+    /// The engine's state beyond the World's, between calls of advanceTo (after exposeState()).
+    virtual void saveState(ByteWriter&) const {}
+    /// Takes the checkpoint's state, in a driver made on the World loaded from it (loadWorld).
+    virtual void loadState(const CheckpointFile&) {}
+    /// Before a checkpoint: the World as it must be saved, without changing what the engine computes next (an
+    /// event-driven engine holding the positions gives them back as they are, unsynchronised).
+    virtual void exposeState() {}
 };
+
+/// The driver's loadState for one engine: the World's particles again (making the engine may have sorted them or
+/// wrapped them into the box), then the engine's own state.
+template <int D, class Engine>
+void loadEngineState(const CheckpointFile& f, World<D>& w, Engine& eng) {
+    ByteReader world = f.section("WRLD");
+    loadWorld(world, w);
+    ByteReader in = f.section("ENGN");
+    eng.loadState(in);
+}
 
 template <int D>
 class TdmDriver final : public Driver<D> {
@@ -130,6 +154,9 @@ public:
     void synchronise() override {}
     void remove(const std::vector<std::uint32_t>& which) override { removeTimeDriven(w_, eng_, which); }
     void added(std::size_t first) override { addTimeDriven(w_, eng_, first); }
+    bool restartable() const override { return true; }
+    void saveState(ByteWriter& out) const override { eng_.saveState(out); }
+    void loadState(const CheckpointFile& f) override { loadEngineState(f, w_, eng_); }
 
 private:
     World<D>& w_;
@@ -174,6 +201,10 @@ public:
         eng_.reset();
     }
     void added(std::size_t) override { eng_.reset(); }
+    bool restartable() const override { return eng_.restartable(); }
+    void exposeState() override { eng_.exposeHeldState(); }
+    void saveState(ByteWriter& out) const override { eng_.saveState(out); }
+    void loadState(const CheckpointFile& f) override { loadEngineState(f, w_, eng_); }
 
 private:
     World<D>& w_;
@@ -345,6 +376,29 @@ public:
         ++count_;
     }
 
+    /// The snapshot count and the collections' entries, for a checkpoint.
+    void saveState(ByteWriter& out) const {
+        out.put<std::int64_t>(count_);
+        savePvd(out, pvd_);
+        savePvd(out, walls_);
+        savePvd(out, zones_);
+        out.put<std::uint8_t>(polys_.has_value());
+        if (polys_) savePvd(out, *polys_);
+    }
+    /// A resumed run's: the collections as they were at the checkpoint (their files rewritten); the snapshots the
+    /// stopped run wrote after it are written again, under the same names.
+    void loadState(ByteReader& in) {
+        count_ = static_cast<int>(in.get<std::int64_t>());
+        if (count_ < 0) in.fail("a negative snapshot count");
+        loadPvd(in, pvd_);
+        loadPvd(in, walls_);
+        loadPvd(in, zones_);
+        if (in.get<std::uint8_t>()) {
+            if (!polys_) polys_.emplace(dir_ / "polygons.pvd");
+            loadPvd(in, *polys_);
+        }
+    }
+
 private:
     /// Zone labels as an image: label 0 event-driven, 1 time-driven (buffer), 2 dense; smoothed fraction phi.
     void writeZones(const HaetEngine<D>& h, double time) {
@@ -414,51 +468,44 @@ void writeFinalPicture(const Scenario& sc, const World<D>& w, const HaetEngine<D
                       materialNames(sc), &polygons);
 }
 
-/// One-line progress on a terminal: simulated time, steps/s, contacts, ETA.
-class Progress {
-public:
-    Progress(bool enabled, double duration) : on_(enabled), duration_(duration), start_(Clock::now()) {}
-    void update(double t, std::uint64_t steps, std::size_t contacts, bool force = false) {
-        if (!on_) return;
-        const auto now = Clock::now();
-        if (!force && now - last_ < std::chrono::milliseconds(200)) return;
-        last_ = now;
-        const double el = std::chrono::duration<double>(now - start_).count();
-        const double frac = std::clamp(t / duration_, 0.0, 1.0);
-        const int width = 30, filled = static_cast<int>(frac * width);
-        const double eta = frac > 0 ? el * (1 - frac) / frac : 0;
-        std::fprintf(stderr, "\r[%s%s] t = %.4g s  %.3g steps/s  %zu contacts  ETA %.0f s   ",
-                     std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), t,
-                     el > 0 ? steps / el : 0.0, contacts, eta);
-        std::fflush(stderr);
-    }
-    void finish() {
-        if (on_) std::fprintf(stderr, "\n");
-    }
-
-private:
-    bool on_;
-    double duration_;
-    Clock::time_point start_, last_{};
-};
-
 template <int D>
 RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
     const auto t0 = Clock::now();
-    const std::filesystem::path dir = opt.outDir.empty() ? std::filesystem::path(sc.output.directory) : opt.outDir;
+    const std::filesystem::path dir = !opt.resumeDir.empty() ? opt.resumeDir
+                                      : opt.outDir.empty()   ? std::filesystem::path(sc.output.directory)
+                                                             : opt.outDir;
 
+    // A resumed run starts from the newest whole checkpoint of its directory: the World built from the scenario
+    // (box, walls, contact table) takes the saved particles, the engine is made on them and takes its own state.
+    std::optional<ResumePoint> resume;
+    if (!opt.resumeDir.empty()) resume = findCheckpoint(dir, sc, log);
     World<D> world = buildWorld<D>(sc);
+    if (resume) {
+        ByteReader in = resume->file.section("WRLD");
+        loadWorld(in, world);
+        in.expectEnd();
+    }
     StopSignals signals;
     std::unique_ptr<Driver<D>> eng = makeDriver<D>(sc, world, signals.flag());
+    if (resume) {
+        if (!eng->restartable())
+            throw std::invalid_argument(std::string("--resume: runs of method \"") + eng->method() +
+                                        "\" cannot be resumed yet");
+        eng->loadState(resume->file);
+    }
     const RunPlan plan = planRun(sc, eng->dt(), world.contact.contactTime);
     for (const auto& [key, what] : plan.warnings) log << "warning: " << key << ": " << what << "\n";
 
-    prepareRunDirectory(dir);
+    if (!resume) prepareRunDirectory(dir);
     std::vector<std::string> columns = {
         "time",         "step",        "kinetic_energy", "rotational_energy", "potential_energy", "elastic_energy",
         "total_energy", "n_particles", "n_contacts",     "max_overlap_ratio", "pressure"};
     for (auto& c : eng->extraColumns()) columns.push_back(c);
     Flow<D> flow(sc, world, eng->stepTime());
+    if (resume) {
+        ByteReader in = resume->file.section("FLOW");
+        flow.loadState(in);
+    }
     for (auto& c : flow.columns()) columns.push_back(c);
     double lastRowTime = world.time;
     auto rowValues = [&](double stamp) {
@@ -485,6 +532,10 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         return row;
     };
 
+    struct {
+        std::uint64_t written = 0, bytes = 0;
+        double seconds = 0;  // wall time spent making and writing them [s]
+    } ckptBook;
     auto writeRunJson = [&](const std::string& status) {
         const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
         JsonObject j;
@@ -498,6 +549,10 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
             j.add("overrides", o);
         }
         j.add("method", eng->method());
+        if (resume) {  // the checkpoint this run went on from
+            j.add("resumed_from", resume->path.filename().string());
+            j.add("resumed_at", resume->file.header.time);
+        }
         j.add("dimension", static_cast<std::int64_t>(D));
         {  // what `haet render` needs besides the snapshots: the box, the materials' names, the picture's settings
             const PictureBox box = pictureBox(world);
@@ -526,12 +581,21 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
             for (const auto& [key, what] : plan.warnings) w.add(key, what);
             j.add("warnings", w);
         }
+        if (ckptBook.written > 0) {  // what the checkpoints of this run cost: their count, last size, time
+            JsonObject c;
+            c.add("written", ckptBook.written);
+            c.add("last_bytes", ckptBook.bytes);
+            c.add("seconds", ckptBook.seconds);
+            j.add("checkpoints", c);
+        }
         j.add("wall_time", wall);
         j.add("particle_steps_per_second", wall > 0 ? double(eng->steps()) * world.particles.size() / wall : 0.0);
         j.add("threads", static_cast<std::int64_t>(omp_get_max_threads()));
         j.add("peak_rss_bytes", peakRssBytes());
         writeFileAtomic(dir / "run.json", j.dump() + "\n");
     };
+    // A resumed run's series.csv as the stopped run left it, read before it is rewritten.
+    std::string savedSeries = resume ? readFileText(dir / "series.csv") : std::string();
     // A run killed before its end (kill -9, a node lost) leaves run.json saying so; it also proves the directory
     // writable before any time is spent.
     writeRunJson("running");
@@ -542,12 +606,33 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                      (opt.progress == ProgressDisplay::Auto && !opt.quiet && isatty(STDERR_FILENO));
     Progress progress(tty, sc.duration);
     const double eps = eng->timeTolerance();
-    OutputClock rows(plan.seriesPeriod), shots(plan.snapshotPeriod);
+    OutputClock rows(plan.seriesPeriod), shots(plan.snapshotPeriod), ckpts(sc.output.checkpointPeriod);
     // The engine is called in the same pieces whether or not the progress line shows (an event-driven engine's
     // state depends on where its calls end): up to every output time and every 1/500 of the run, at which the
     // progress line may update (at most every 200 ms).
     OutputClock chunks(sc.duration / 500);
     double lastRow = -1, lastShot = -1;  // engine times of the last row and snapshot written
+    double lastCheckpoint = -1;          // engine time of the last checkpoint
+    std::uint64_t sequence = 0;          // of the last checkpoint written
+    if (resume) {
+        // The outputs as they were when the checkpoint was written: series.csv up to its rows (a stopped run's
+        // last-state row after it is not the schedule's), the collections' entries; the clocks from the times of
+        // the last outputs, so that periods changed on resume take effect from here.
+        ByteReader in = resume->file.section("RUN ");
+        sequence = in.get<std::uint64_t>();
+        lastRow = in.get<double>();
+        lastShot = in.get<double>();
+        lastRowTime = in.get<double>();
+        const SeriesMark mark = loadSeriesMark(in);
+        snaps.loadState(in);
+        in.expectEnd();
+        series.resume(seriesAtCheckpoint(std::move(savedSeries), mark, series.path(), resume->path), mark.rows);
+        if (lastRow >= 0) rows.pass(lastRow, eps);
+        if (lastShot >= 0) shots.pass(lastShot, eps);
+        ckpts.pass(world.time, eps);
+        lastCheckpoint = world.time;
+        log << "resuming from " << resume->path.string() << " at t = " << world.time << " s\n";
+    }
     auto row = [&](double stamp) {
         eng->synchronise();
         series.row(rowValues(stamp));
@@ -558,6 +643,51 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         snaps.write(world, stamp, eng->hybrid());
         series.flush();
         lastShot = world.time;
+    };
+    // A checkpoint: the whole state at world.time and the outputs written so far (series.csv flushed first, so
+    // that the file on disk always holds at least the rows a checkpoint counts).
+    const bool checkpoints = eng->restartable();
+    if (!checkpoints && sc.output.checkpointPeriod > 0)
+        log << "warning: output.checkpoint_period: runs of method \"" << eng->method()
+            << "\" write no checkpoints yet\n";
+    auto checkpoint = [&] {
+        if (!checkpoints) return;
+        const auto start = Clock::now();
+        eng->exposeState();
+        series.flush();
+        ByteWriter body;
+        body.beginSection("SCEN");
+        body.putString(sc.stateKeys);
+        body.endSection();
+        body.beginSection("WRLD");
+        saveWorld(body, world);
+        body.endSection();
+        body.beginSection("ENGN");
+        eng->saveState(body);
+        body.endSection();
+        body.beginSection("FLOW");
+        flow.saveState(body);
+        body.endSection();
+        body.beginSection("RUN ");
+        body.put<std::uint64_t>(sequence + 1);
+        body.put<double>(lastRow);
+        body.put<double>(lastShot);
+        body.put<double>(lastRowTime);
+        saveSeriesMark(body, series);
+        snaps.saveState(body);
+        body.endSection();
+        CheckpointHeader h;
+        h.dimension = D;
+        h.method = eng->method();
+        h.scenarioHash = sc.stateHash;
+        h.time = world.time;
+        h.sequence = ++sequence;
+        const std::string file = encodeCheckpoint(h, body.bytes());
+        writeCheckpoint(dir, sequence, file);
+        lastCheckpoint = world.time;
+        ckptBook.written += 1;
+        ckptBook.bytes = file.size();
+        ckptBook.seconds += std::chrono::duration<double>(Clock::now() - start).count();
     };
     RunStatus status = RunStatus::Completed;
     std::string statusText = "completed";
@@ -571,9 +701,13 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                 shot(OutputClock::stamp(world.time, shots.next()));
                 shots.pass(world.time, eps);
             }
+            if (ckpts.due(world.time, eps)) {
+                if (lastCheckpoint != world.time) checkpoint();
+                ckpts.pass(world.time, eps);
+            }
             if (world.time + eps >= sc.duration || signals.requested()) break;
             // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
-            const double target = std::min({sc.duration, rows.next(), shots.next(), flow.nextTime()});
+            const double target = std::min({sc.duration, rows.next(), shots.next(), ckpts.next(), flow.nextTime()});
             while (chunks.due(world.time, eps)) chunks.pass(world.time, eps);
             eng->advanceTo(chunks.next() < target - eps ? chunks.next() : target);
             if (world.time + eps >= flow.nextTime()) flow.act(world, *eng, eps);
@@ -600,9 +734,11 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         log << (signals.signal() == SIGINT ? "\nSIGINT" : "\nSIGTERM") << ": stopped at t = " << world.time
             << " s; writing the last state\n";
     }
-    // The last state, always: a row and a snapshot at the time the run ended, unless the schedule just wrote them.
-    // (A checkpoint of the whole state, for a restart, would be written here too, before run.json closes the run.)
+    // The last state, always: a checkpoint (before the last row and snapshot, which are not the schedule's: a
+    // resumed run drops them), then a row and a snapshot at the time the run ended, unless the schedule just wrote
+    // them. A blown-up state is not checkpointed: the last checkpoint stays the newest.
     try {
+        if (status != RunStatus::BlewUp && lastCheckpoint != world.time) checkpoint();
         if (lastRow != world.time) row(OutputClock::stamp(world.time, sc.duration));
         if (lastShot != world.time) shot(OutputClock::stamp(world.time, sc.duration));
     } catch (const SimulationError& e) {  // a blown-up state the engine cannot bring to one time
@@ -611,6 +747,11 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     progress.update(world.time, eng->steps(), eng->contacts(), true);
     progress.finish();
     series.flush();
+    // The state for a next stage (run/export.hpp): disks and spheres, unless the run blew up.
+    if (status != RunStatus::BlewUp && !world.particles.hasPolygons() && world.particles.hasMotion()) {
+        writeStateCsv(dir / "final.csv", world, sc.materials);
+        writeLammpsData(dir / "final.data", world, sc.materials);
+    }
     writeRunJson(statusText);
     writeFinalPicture(sc, world, eng->hybrid(), dir / "final.png");
     if (!opt.quiet) {
@@ -621,150 +762,11 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     return status;
 }
 
-/// The sections of docs/physics.md behind what `haet check` prints for the time-driven side of a run.
-std::string tdmReferences(const Scenario& sc, IntegratorKind integrator, bool polygons) {
-    std::string r = sc.contact.normal == NormalLaw::Linear ? "B.2 linear spring-dashpot" : "B.3 Hertz";
-    if (sc.contact.tangential == TangentialLaw::Spring) r += ", B.4 tangential spring";
-    if (polygons) r += ", G polygons";
-    r += integrator == IntegratorKind::Gear5 ? ", F.1 Gear predictor-corrector" : ", F.2 velocity Verlet";
-    return r + ", F.3 time step";
-}
-
-template <int D>
-void describeTdm(const Scenario& sc, std::ostream& out) {
-    World<D> world = buildWorld<D>(sc);
-    std::string dtNote;
-    const TdmSettings ts = tdmSettings<D>(sc, world, &dtNote);
-    TdmEngine<D> eng(world, ts);
-    const std::size_t n = world.particles.size();
-    const std::size_t pairs = eng.pairs().size();
-    // Memory: particle arrays (x, v, f, mean velocity over the step, position at the list build; w, torque,
-    // mean spin, and a polygon's orientation; radius, mass, 1/m, 1/I, id; image flags; list offset, material, flags) +
-    // integrator history (Gear's higher derivatives; velocity Verlet keeps none) + pair list (partner, owner,
-    // shift, spring).
-    const std::size_t gearHistory = 4 * (sizeof(Vec<D>) + sizeof(Ang<D>));
-    const std::size_t perParticle = sizeof(Vec<D>) * 5 + sizeof(Ang<D>) * (world.particles.hasPolygons() ? 4 : 3) +
-                                    8 * 5 + 4 * D + 8 + (ts.integrator == IntegratorKind::Gear5 ? gearHistory : 0);
-    const std::size_t perPair = 4 + 4 + 1 + sizeof(Vec<D>);
-    const double steps = std::ceil(sc.duration / ts.dt);
-    out << fmt::format("scenario   {} ({})\n", sc.name, sc.path);
-    out << fmt::format("method     tdm, {}D, integrator {}\n", D,
-                       ts.integrator == IntegratorKind::Gear5 ? "gear5" : "verlet");
-    out << fmt::format("particles  {} ({} frozen), {} materials, {} walls\n", n,
-                       std::count_if(world.particles.flags.begin(), world.particles.flags.end(),
-                                     [](std::uint8_t f) { return f & kFrozen; }),
-                       sc.materials.size(), world.walls.size() + world.surfaces.size());
-    describeWalls(world, out);
-    if (world.particles.hasPolygons())
-        out << fmt::format("polygons   {} ({}; the rest are disks)\n", world.particles.shapes.size(),
-                           sc.contact.polygonLaw == PolygonLaw::Potential
-                               ? "potential law Y A |c| / L^2 at the chord midpoint, energy-conserving"
-                               : "overlap-area law Y A / l, docs/physics.md G.3");
-    out << fmt::format("contact    {} normal law, {} tangential; contact duration t_c = {:.4g} s ({})\n",
-                       sc.contact.normal == NormalLaw::Linear ? "linear" : "hertz",
-                       sc.contact.tangential == TangentialLaw::Spring ? "spring" : "no", world.contact.contactTime,
-                       world.contact.contactTimeNote);
-    out << fmt::format("time step  dt = {:.4g} s ({}); {:.0f} steps for {:.4g} s\n", ts.dt, dtNote, steps, sc.duration);
-    out << fmt::format("neighbours skin {:.4g} m, {} pairs in the initial list\n", ts.skin, pairs);
-    out << fmt::format("memory     about {:.1f} MB ({} bytes per particle)\n",
-                       (n * perParticle + pairs * perPair) / 1e6, n ? (n * perParticle + pairs * perPair) / n : 0);
-    for (std::size_t a = 0; a < sc.materials.size(); ++a)
-        out << fmt::format("material   {}: restitution of the soft law {:.5f} (incl. contact-end rule)\n",
-                           sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
-    out << fmt::format("physics    docs/physics.md {}\n",
-                       tdmReferences(sc, ts.integrator, world.particles.hasPolygons()));
-}
-
 }  // namespace
 
 RunStatus runScenario(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
     if (opt.threads > 0) omp_set_num_threads(opt.threads);
     return sc.dimension == 2 ? runWorld<2>(sc, opt, log) : runWorld<3>(sc, opt, log);
-}
-
-template <int D>
-void describeEdm(const Scenario& sc, std::ostream& out) {
-    World<D> world = buildWorld<D>(sc);
-    const double tc = sc.edm.tcTime.value_or(world.contact.contactTime);
-    out << fmt::format("scenario   {} ({})\n", sc.name, sc.path);
-    out << fmt::format("method     edm (event-driven), {}D, tangential {}\n", D,
-                       sc.edm.tangential == EdmTangential::Constant ? "constant beta" : "Walton's rule");
-    out << fmt::format("particles  {}, {} materials, {} walls\n", world.particles.size(), sc.materials.size(),
-                       world.walls.size() + world.surfaces.size());
-    describeWalls(world, out);
-    out << fmt::format("collapse   TC model {} (tc_time = {:.4g} s)\n", sc.edm.tcModel ? "on" : "off", tc);
-    for (std::size_t a = 0; a < sc.materials.size(); ++a)
-        out << fmt::format("material   {}: restitution {:.5f} (the soft law's, incl. contact-end rule)\n",
-                           sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
-    out << fmt::format(
-        "physics    docs/physics.md C.1-C.2 collision rule, D.2-D.4 event times, D.6 invalid states{}{}\n",
-        sc.edm.tcModel ? ", D.7 TC model" : "", world.surfaces.empty() ? "" : ", D.8 mesh walls");
-}
-
-template <int D>
-void describeHaet(const Scenario& sc, std::ostream& out) {
-    World<D> world = buildWorld<D>(sc);
-    std::string dtNote;
-    const TdmSettings ts = tdmSettings<D>(sc, world, &dtNote);
-    const HaetEngine<D> eng(world, ts, edmSettings(sc), haetSettings<D>(sc));
-    const HaetSettings& hs = eng.settings();
-    out << fmt::format("scenario   {} ({})\n", sc.name, sc.path);
-    out << fmt::format("method     haet (time-driven where dense, event-driven where dilute), {}D, integrator {}\n", D,
-                       ts.integrator == IntegratorKind::Gear5 ? "gear5" : "verlet");
-    out << fmt::format("particles  {}: {} time-driven, {} event-driven at the start; {} walls\n",
-                       world.particles.size(), eng.nTdm(), eng.nEdm(), world.walls.size() + world.surfaces.size());
-    describeWalls(world, out);
-    out << fmt::format("contact    t_c = {:.4g} s ({})\n", world.contact.contactTime, world.contact.contactTimeNote);
-    out << fmt::format("time step  dt = {:.4g} s ({}); {:.0f} steps for {:.4g} s\n", ts.dt, dtNote,
-                       std::ceil(sc.duration / ts.dt), sc.duration);
-    const ZoneGrid<D>& z = eng.zones();
-    std::string dims;
-    for (int k = 0; k < D; ++k) dims += (k ? " x " : "") + std::to_string(z.dims()[k]);
-    out << fmt::format(
-        "zones      edge {:.4g} m ({} zones), phi_on {:.3g}, phi_off {:.3g}, buffer {}, "
-        "relabel every {} steps, dilute_steps {}\n",
-        hs.zones.size, dims, hs.zones.phiOn, hs.zones.phiOff, hs.zones.buffer, hs.relabelEvery, hs.diluteSteps);
-    out << fmt::format("events     cell edge {:.4g} m ({})\n", eng.edm().cellSize(),
-                       sc.edm.cellSize ? "[edm] cell_size, at least one diameter plus the skin"
-                                       : "from the event-driven particles' density, docs/haet.md");
-    out << fmt::format(
-        "collapse   modified EDM: dt_min = {:.4g} s (a collision sooner hands both particles to the TDM)\n",
-        eng.dtMin());
-    for (std::size_t a = 0; a < sc.materials.size(); ++a)
-        out << fmt::format(
-            "material   {}: restitution {:.5f} in both engines (the soft law's, incl. contact-end rule)\n",
-            sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
-    out << fmt::format(
-        "physics    docs/physics.md A.1 one physics, A.2 zones, A.4 modified EDM; {}; C.1-C.2 collision rule, "
-        "D.2-D.4 event times{}\n",
-        tdmReferences(sc, ts.integrator, false),
-        world.surfaces.empty() ? "" : ", D.8 mesh walls, H.6 walls the event-driven part leaves to the time-driven");
-}
-
-static void describeMethod(const Scenario& sc, std::ostream& out) {
-    if (sc.method == Method::Haet) {
-        if (sc.dimension == 2)
-            describeHaet<2>(sc, out);
-        else
-            describeHaet<3>(sc, out);
-        return;
-    }
-    if (sc.method == Method::Edm) {
-        if (sc.dimension == 2)
-            describeEdm<2>(sc, out);
-        else
-            describeEdm<3>(sc, out);
-        return;
-    }
-    if (sc.dimension == 2)
-        describeTdm<2>(sc, out);
-    else
-        describeTdm<3>(sc, out);
-}
-
-void describeScenario(const Scenario& sc, std::ostream& out) {
-    describeMethod(sc, out);
-    describeFlows(sc, out);
 }
 
 }  // namespace haet

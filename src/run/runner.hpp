@@ -19,6 +19,9 @@ struct RunOptions {
     int threads = 0;               ///< 0: OpenMP default
     bool quiet = false;            ///< no progress bar and no summary
     ProgressDisplay progress = ProgressDisplay::Auto;
+    /// Non-empty: go on from the newest whole checkpoint of this run directory (which is also the output
+    /// directory), instead of starting at t = 0 (docs/scenario.md, "Resuming").
+    std::filesystem::path resumeDir;
 };
 
 /// The exit code of `haet run` for each outcome.

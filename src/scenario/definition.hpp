@@ -233,6 +233,7 @@ struct OutputDef {
     std::optional<std::array<double, 2>> colorRange;
     Vec3d view{0, 1, 0};
     int pictureWidth = 900;
+    double checkpointPeriod = 0;  ///< [s] between checkpoints; 0 = none but the one at the end (and at a stop)
     SourcePos pos;
 };
 
@@ -258,7 +259,11 @@ struct Scenario {
     std::vector<OutletDef> outlets;
     std::vector<InletDef> inlets;
     OutputDef output;
-    std::string hash;                    ///< hash of the file contents (hex)
+    std::string hash;  ///< hash of the file contents (hex)
+    /// Every key a resume may not change (docs/scenario.md, "Resuming"), one "key = value" line each, after the
+    /// overrides, in key order: what a checkpoint records of its scenario, and stateHash its hash (hex).
+    std::string stateKeys;
+    std::string stateHash;
     std::vector<std::string> overrides;  ///< command-line overrides applied to the file, "KEY=VALUE" (loader.hpp)
 };
 

@@ -462,12 +462,13 @@ void readColumnFile(const std::filesystem::path& file, const std::string& key, c
 
 ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
                              const std::vector<MaterialDef>& materials, const std::string& key) {
-    enum Column { X, Y, Z, Radius, Vx, Vy, Vz, Material, Frozen, kColumns };
-    static const char* const columnName[kColumns] = {"x", "y", "z", "radius", "vx", "vy", "vz", "material", "frozen"};
+    enum Column { X, Y, Z, Radius, Vx, Vy, Vz, Wx, Wy, Wz, Ix, Iy, Iz, Material, Frozen, kColumns };
+    static const char* const columnName[kColumns] = {"x",  "y",  "z",  "radius", "vx", "vy",       "vz",    "wx",
+                                                     "wy", "wz", "ix", "iy",     "iz", "material", "frozen"};
     ParticleFile out;
     auto header = [&](const std::array<int, kColumns>& col, const auto& fail) {
         if (dimension == 2)
-            for (int j : {int(Z), int(Vz)})
+            for (int j : {int(Z), int(Vz), int(Wx), int(Wy), int(Iz)})
                 if (col[std::size_t(j)] >= 0)
                     fail(std::string("column ") + inQuotes(columnName[j]) + " is not used in a 2D scenario");
         for (int j : {int(X), int(Y), int(Z), int(Radius)}) {
@@ -492,11 +493,21 @@ ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
             p.v[1] = r.number(Vy);
             if (dimension == 3) p.v[2] = r.number(Vz);
         }
+        // Spins and image flags (a saved state: final.csv), each column on its own; absent ones are zero.
+        for (int a = 0; a < 3; ++a) {
+            if (r.has(std::size_t(Wx + a))) p.w[std::size_t(a)] = r.number(std::size_t(Wx + a));
+            if (!r.has(std::size_t(Ix + a))) continue;
+            const double f = r.number(std::size_t(Ix + a));
+            if (!(f == std::floor(f)) || std::abs(f) > 2147483647.0)
+                r.fail(std::string("column ") + columnName[Ix + a] + ": expected an integer (box crossings)");
+            p.image[std::size_t(a)] = static_cast<int>(f);
+        }
         if (r.has(Material)) p.material = materialCell(r.cell(Material), materials, r.fail);
         if (r.has(Frozen)) p.frozen = frozenCell(r.cell(Frozen), r.fail);
         out.particles.push_back(p);
     };
-    readColumnFile(file, key, columnName, "the header names columns x, y, z, radius, vx, vy, vz, material, frozen",
+    readColumnFile(file, key, columnName,
+                   "the header names columns x, y, z, radius, vx, vy, vz, wx, wy, wz, ix, iy, iz, material, frozen",
                    "particle", header, record);
     return out;
 }

@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -504,8 +505,8 @@ private:
 
     void readOutput(Scenario& s) {
         const TableReader r = child("output");
-        r.allowOnly(
-            {"directory", "series_period", "snapshot_period", "color_by", "color_range", "view", "picture_width"});
+        r.allowOnly({"directory", "series_period", "snapshot_period", "checkpoint_period", "color_by", "color_range",
+                     "view", "picture_width"});
         OutputDef& o = s.output;
         o.pos = r.tablePos();
         o.directory = r.string("directory").value_or(o.directory);
@@ -513,6 +514,9 @@ private:
         o.seriesPeriod = r.number("series_period").value_or(o.seriesPeriod);
         if (!(o.seriesPeriod >= 0)) r.fail("series_period", "must be >= 0");
         o.snapshotPeriod = r.number("snapshot_period").value_or(o.snapshotPeriod);
+        o.checkpointPeriod = r.number("checkpoint_period").value_or(o.checkpointPeriod);
+        if (!(o.checkpointPeriod >= 0) || !std::isfinite(o.checkpointPeriod))
+            r.fail("checkpoint_period", "must be a finite number >= 0 (0: only at the end)");
         checkOutputCounts(r, s);
         readPicture(r, s);
     }
@@ -579,6 +583,11 @@ private:
             r.fail("snapshot_period", formatNumber(o.snapshotPeriod) + " s asks for " +
                                           formatNumber(std::floor(s.duration / o.snapshotPeriod)) + " snapshots over " +
                                           formatNumber(s.duration) + " s; at most " + formatNumber(kMaxSnapshots));
+        if (o.checkpointPeriod > 0 && s.duration / o.checkpointPeriod > kMaxSnapshots)
+            r.fail("checkpoint_period", formatNumber(o.checkpointPeriod) + " s asks for " +
+                                            formatNumber(std::floor(s.duration / o.checkpointPeriod)) +
+                                            " checkpoints over " + formatNumber(s.duration) + " s; at most " +
+                                            formatNumber(kMaxSnapshots));
     }
 
     TableReader root_;
@@ -697,6 +706,75 @@ std::string applyOverride(toml::table& root, const std::string& text, const std:
     return key + "=" + value;
 }
 
+/// The keys a resume may change (docs/scenario.md, "Resuming"): when the run ends and what it writes, never what
+/// it computes.
+bool safeOnResume(const std::string& key) { return key == "duration" || key.rfind("output.", 0) == 0; }
+
+/// A number as the shortest text that reads back to it (0.7, not 0.69999999999999996).
+std::string shortest(double x) {
+    char text[32];
+    return std::string(text, std::to_chars(text, text + sizeof text, x).ptr);
+}
+
+/// A value in TOML syntax, numbers shortest.
+std::string valueText(const toml::node& node) {
+    if (const auto* d = node.as_floating_point()) return shortest(d->get());
+    if (const toml::array* a = node.as_array()) {
+        std::string s = "[";
+        for (std::size_t i = 0; i < a->size(); ++i) s += (i ? ", " : "") + valueText(*a->get(i));
+        return s + "]";
+    }
+    if (const toml::table* t = node.as_table()) {
+        std::string s = "{";
+        for (const auto& [k, v] : *t) s += (s.size() > 1 ? ", " : " ") + std::string(k.str()) + " = " + valueText(v);
+        return s + " }";
+    }
+    std::ostringstream os;  // integers, booleans, strings (quoted and escaped), dates
+    node.visit([&](const auto& v) { os << v; });
+    return os.str();
+}
+
+/// Every leaf of the table as "key = value" lines, keys as the errors write them (insert[2].radius), in key order.
+void flattenKeys(const toml::table& t, const std::string& prefix, std::string& out) {
+    for (const auto& [k, node] : t) {
+        const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+        if (const toml::table* sub = node.as_table()) {
+            flattenKeys(*sub, key, out);
+            continue;
+        }
+        const toml::array* a = node.as_array();
+        if (a && a->is_array_of_tables()) {
+            for (std::size_t i = 0; i < a->size(); ++i)
+                flattenKeys(*a->get(i)->as_table(), key + "[" + std::to_string(i + 1) + "]", out);
+            continue;
+        }
+        if (safeOnResume(key)) continue;
+        out += key + " = " + valueText(node) + "\n";
+    }
+}
+
+/// The values that follow from duration unless the file sets them (an inlet's end and interval, an outlet's
+/// interval): a resume that changes duration would change them, and with them the run, so they are part of what a
+/// resume may not change, as "key = value (the default: ...)" lines.
+void appendDurationDefaults(const toml::table& root, const Scenario& s, std::string& out) {
+    auto given = [&](const char* array, std::size_t k, const char* key) {
+        const toml::array* a = root[array].as_array();
+        const toml::table* t = a && k < a->size() ? a->get(k)->as_table() : nullptr;
+        return t && t->contains(key);
+    };
+    auto line = [&](const std::string& key, double value) {
+        out += key + " = " + shortest(value) + " (the default, from duration: set it to change duration)\n";
+    };
+    for (std::size_t k = 0; k < s.inlets.size(); ++k) {
+        const std::string at = "inlet[" + std::to_string(k + 1) + "].";
+        if (!given("inlet", k, "end")) line(at + "end", s.inlets[k].end);
+        if (!given("inlet", k, "interval")) line(at + "interval", s.inlets[k].interval);
+    }
+    for (std::size_t k = 0; k < s.outlets.size(); ++k)
+        if (!given("outlet", k, "interval"))
+            line("outlet[" + std::to_string(k + 1) + "].interval", s.outlets[k].interval);
+}
+
 }  // namespace
 
 std::string fnv1a64Hex(std::string_view bytes) {
@@ -731,6 +809,9 @@ Scenario parseScenario(std::string_view text, const std::filesystem::path& file,
     }
     Scenario s = Loader(root, name, file.parent_path()).load();
     s.hash = fnv1a64Hex(text);
+    flattenKeys(root, "", s.stateKeys);
+    appendDurationDefaults(root, s, s.stateKeys);
+    s.stateHash = fnv1a64Hex(s.stateKeys);
     s.overrides = std::move(applied);
     return s;
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "contact/kinds.hpp"
+#include "io/checkpoint.hpp"
 #include "neighbor/pair_list.hpp"
 #include "tdm/forces.hpp"
 #include "tdm/integrators.hpp"
@@ -78,6 +79,15 @@ public:
     std::size_t wallContacts() const;
     /// The walls of any shape as the last force pass saw them: poses, candidates, contacts (for tests).
     const SurfaceState<D>& surfaceState() const { return surf_; }
+
+    /// What the engine keeps beyond the World, for a checkpoint (tdm/state.cpp): the pair list with its springs, the
+    /// planes' springs, the contacts with walls of any shape and their candidates, the integrator's history, the
+    /// step's mean velocities, the counters and the start time. Between calls of advanceTo only (a step boundary).
+    void saveState(ByteWriter& out) const;
+    /// Replaces that state with a saved one, in an engine made for the same scenario on a World whose particles
+    /// were loaded from the same checkpoint: the run then goes on as the saved one would have, bit for bit.
+    /// Throws CheckpointError (Corrupt) when the sizes do not fit the World.
+    void loadState(ByteReader& in);
 
 private:
     /// Forces at the current (predicted) state; with correct, also the integrator's corrector; with nextMoved

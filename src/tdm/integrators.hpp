@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/particles.hpp"
+#include "io/checkpoint.hpp"
 
 namespace haet {
 
@@ -38,6 +39,9 @@ public:
     /// After the particle set changed: new particle k was old particle from[k], or is new (0xFFFFFFFF) and
     /// restarts from its current state and force.
     virtual void remap(const Particles<D>& p, const std::vector<std::uint32_t>& from, double dt) = 0;
+    /// The integrator's own history, for a checkpoint (none for velocity Verlet); load takes n particles' worth.
+    virtual void saveState(ByteWriter&) const {}
+    virtual void loadState(ByteReader&, std::size_t) {}
 };
 
 /// Velocity Verlet (Swope et al. 1982; F.2). Forces see v* = v + a(t) dt, the explicit estimate of v(t+dt).
@@ -167,6 +171,14 @@ public:
     /// consistent start-up when the caller knows them (docs/physics.md F.1 start-up pitfall).
     void setDerivatives(std::size_t i, const Vec<D>& a, const Vec<D>& j3, const Vec<D>& j4, const Vec<D>& j5,
                         double dt);
+    void saveState(ByteWriter& out) const override {
+        for (const auto& a : y_) out.putVector(a);
+        for (const auto& a : r_) out.putVector(a);
+    }
+    void loadState(ByteReader& in, std::size_t n) override {
+        for (auto& a : y_) in.getVector(a, n, "a Gear derivative of positions");
+        for (auto& a : r_) in.getVector(a, n, "a Gear derivative of angles");
+    }
 
 private:
     std::vector<Vec<D>> y_[4];  ///< y2..y5 of positions

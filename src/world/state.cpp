@@ -1,0 +1,95 @@
+#include "world/state.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace haet {
+
+template <int D>
+void saveWorld(ByteWriter& out, const World<D>& w) {
+    const Particles<D>& p = w.particles;
+    if (!p.hasMotion()) throw std::logic_error("saveWorld: the particles' positions are held by an engine");
+    out.put<double>(w.time);
+    out.put<std::uint64_t>(p.size());
+    out.put<std::uint64_t>(p.nTdm);  // as set: all (-1) takes in later particles, a count does not
+    out.put<std::uint8_t>(p.hasTdmState());
+    out.putVector(p.x);
+    out.putVector(p.v);
+    out.putVector(p.w);
+    out.putVector(p.f);
+    out.putVector(p.torque);
+    out.putVector(p.radius);
+    out.putVector(p.invMass);
+    out.putVector(p.invInertia);
+    out.putVector(p.material);
+    out.putVector(p.flags);
+    out.putVector(p.mass);
+    out.putVector(p.id);
+    out.putVector(p.image);
+    out.putVector(p.shape);
+    out.putVector(p.angle);
+    out.putVector(p.shapes.first);
+    out.putVector(p.shapes.vertices);
+    out.putVector(p.shapes.inertiaPerMass);
+    out.putVector(p.shapes.area);
+}
+
+template <int D>
+void loadWorld(ByteReader& in, World<D>& w) {
+    Particles<D>& p = w.particles;
+    const double time = in.get<double>();
+    if (!std::isfinite(time)) in.fail("the time is not finite");
+    const auto n = in.get<std::uint64_t>();
+    const auto nTdm = in.get<std::uint64_t>();
+    const bool tdmState = in.get<std::uint8_t>() != 0;
+    if (nTdm > n && nTdm != std::uint64_t(-1)) in.fail("more time-driven particles than particles");
+    if (n > in.rest().size() / (2 * sizeof(Vec<D>))) in.fail("more particles than the bytes left hold");
+    Particles<D> q;
+    if (!tdmState) q.dropTdmState();
+    in.getVector(q.x, n, "x");
+    in.getVector(q.v, n, "v");
+    in.getVector(q.w, n, "w");
+    in.getVector(q.f, tdmState ? n : 0, "f");
+    in.getVector(q.torque, tdmState ? n : 0, "torque");
+    in.getVector(q.radius, n, "radius");
+    in.getVector(q.invMass, n, "1/m");
+    in.getVector(q.invInertia, n, "1/I");
+    in.getVector(q.material, n, "material");
+    in.getVector(q.flags, n, "flags");
+    in.getVector(q.mass, n, "mass");
+    in.getVector(q.id, n, "id");
+    in.getVector(q.image, n, "image");
+    in.getVector(q.shape);
+    in.getVector(q.angle, q.shape.size(), "angle");
+    if (!q.shape.empty() && q.shape.size() != n) in.fail("shape has " + std::to_string(q.shape.size()) + " entries");
+    in.getVector(q.shapes.first);
+    in.getVector(q.shapes.vertices);
+    in.getVector(q.shapes.inertiaPerMass);
+    in.getVector(q.shapes.area, q.shapes.inertiaPerMass.size(), "the shapes' areas");
+    const std::size_t nShapes = q.shapes.area.size();
+    if (q.shapes.first.size() != nShapes + 1 || q.shapes.first.front() != 0 ||
+        q.shapes.first.back() != q.shapes.vertices.size() ||
+        !std::is_sorted(q.shapes.first.begin(), q.shapes.first.end()))
+        in.fail("the shape table's offsets do not fit its vertices");
+    for (std::size_t s = 0; s < nShapes; ++s)
+        if (q.shapes.count(std::uint32_t(s)) < 3) in.fail("a polygon with fewer than 3 vertices");
+    for (std::uint32_t s : q.shape)
+        if (s != kNoShape && s >= nShapes) in.fail("a particle's shape is out of range");
+    if constexpr (D == 3)
+        if (!q.shape.empty()) in.fail("polygons in a 3D run");
+    for (std::uint16_t m : q.material)
+        if (int(m) >= w.contact.nMaterials) in.fail("a particle's material is not in the scenario");
+    for (double r : q.radius)
+        if (!(r > 0) || !std::isfinite(r)) in.fail("a radius is not a positive number");
+    q.nTdm = nTdm;
+    p = std::move(q);
+    w.time = time;
+    for (Wall<D>& wall : w.walls) wall.moveTo(time);
+}
+
+template void saveWorld<2>(ByteWriter&, const World<2>&);
+template void saveWorld<3>(ByteWriter&, const World<3>&);
+template void loadWorld<2>(ByteReader&, World<2>&);
+template void loadWorld<3>(ByteReader&, World<3>&);
+
+}  // namespace haet
