@@ -22,6 +22,20 @@ inline Scenario exampleScenario(const std::string& name, const std::vector<std::
     return loadScenario(std::filesystem::path(HAET_SOURCE_DIR) / "examples" / name, overrides);
 }
 
+/// The mean of a sample and its standard deviation (n - 1 in the denominator; 0 for fewer than two values).
+struct SampleStats {
+    double mean = 0, sd = 0;
+};
+inline SampleStats sampleStats(const std::vector<double>& v) {
+    SampleStats s;
+    for (double x : v) s.mean += x;
+    s.mean /= double(v.size());
+    double var = 0;
+    for (double x : v) var += (x - s.mean) * (x - s.mean);
+    s.sd = v.size() > 1 ? std::sqrt(var / double(v.size() - 1)) : 0;
+    return s;
+}
+
 /// Whether two arrays hold the same bits (not only equal values: -0 and 0, NaNs told apart).
 template <class T>
 bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {

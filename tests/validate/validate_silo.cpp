@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "../physics_util.hpp"
 #include "run/runner.hpp"
 #include "scenario/loader.hpp"
 
@@ -35,10 +36,9 @@ struct Series {
 };
 
 Series runSilo(const std::string& method, int seed, double duration) {
-    const fs::path file = fs::path(HAET_SOURCE_DIR) / "examples" / "silo2d_reduced.toml";
-    const Scenario sc = parseScenario(readScenarioText(file), file,
-                                      {"method=" + method, "seed=" + std::to_string(seed),
-                                       "duration=" + std::to_string(duration), "output.snapshot_period=-1"});
+    const Scenario sc = testing::exampleScenario("silo2d_reduced.toml",
+                                                 {"method=" + method, "seed=" + std::to_string(seed),
+                                                  "duration=" + std::to_string(duration), "output.snapshot_period=-1"});
     RunOptions o;
     o.outDir = fs::temp_directory_path() /
                ("haet_silo_" + std::to_string(::getpid()) + "_" + method + "_" + std::to_string(seed));
@@ -85,12 +85,10 @@ Rate rateOver(const Series& s, double t0, double t1, double block) {
     std::vector<double> rates;
     for (double a = t0; a + block <= t1 + 1e-9; a += block)
         rates.push_back((drainedAt(a + block) - drainedAt(a)) / block);
+    const testing::SampleStats st = testing::sampleStats(rates);
     Rate r;
-    for (double x : rates) r.mean += x;
-    r.mean /= double(rates.size());
-    double var = 0;
-    for (double x : rates) var += (x - r.mean) * (x - r.mean);
-    r.error = std::sqrt(var / double(rates.size() - 1) / double(rates.size()));
+    r.mean = st.mean;
+    r.error = st.sd / std::sqrt(double(rates.size()));
     return r;
 }
 
@@ -156,13 +154,8 @@ TEST(SiloValidate, HybridDischargesAtTheTimeDrivenRate) {
             if (h.time[r] >= 0.3) nt += h.tdm[r], n += h.present[r];
         edmShare += (1 - nt / n) / kSeeds;
     }
-    auto mean = [](const std::vector<double>& v) { return (v[0] + v[1] + v[2]) / 3; };
-    auto sd = [&](const std::vector<double>& v) {
-        const double m = mean(v);
-        double s = 0;
-        for (double x : v) s += (x - m) * (x - m);
-        return std::sqrt(s / 2);
-    };
+    auto mean = [](const std::vector<double>& v) { return testing::sampleStats(v).mean; };
+    auto sd = [](const std::vector<double>& v) { return testing::sampleStats(v).sd; };
     const double spread = std::hypot(sd(tdm), sd(haet)) / std::sqrt(3.0);
     EXPECT_GT(edmShare, 0.03) << "the jet must be event-driven in the hybrid";
     EXPECT_NEAR(mean(haet), mean(tdm), std::max(3 * spread, 0.02 * mean(tdm)))

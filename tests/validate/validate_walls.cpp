@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "../physics_util.hpp"
 #include "../world_util.hpp"
 #include "geometry/surface.hpp"
 #include "scenario/loader.hpp"
@@ -123,13 +124,8 @@ TEST(WallsValidate, CylinderAndItsMeshPackAlike) {
         analytic.push_back(cylinderPacking(false, seed));
         mesh.push_back(cylinderPacking(true, seed));
     }
-    auto mean = [](const std::vector<double>& v) { return (v[0] + v[1] + v[2]) / 3; };
-    auto sd = [&](const std::vector<double>& v) {
-        const double m = mean(v);
-        double s = 0;
-        for (double x : v) s += (x - m) * (x - m);
-        return std::sqrt(s / 2);
-    };
+    auto mean = [](const std::vector<double>& v) { return testing::sampleStats(v).mean; };
+    auto sd = [](const std::vector<double>& v) { return testing::sampleStats(v).sd; };
     const double spread = std::sqrt(sd(analytic) * sd(analytic) + sd(mesh) * sd(mesh)) / std::sqrt(3.0);
     EXPECT_GT(mean(analytic), 0.5);
     EXPECT_LT(mean(analytic), 0.66);
