@@ -3,8 +3,10 @@
 // kind of scene, on one and two threads; a checkpoint that is truncated, corrupt, of a later format or of another
 // scenario is refused with exit code 2 and a message that says which, and a corrupt newest one gives way to the one
 // before it. The runs are of the `haet` program, on scenes of examples/ shortened by overrides.
+#include <algorithm>
 #include <csignal>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,6 +27,28 @@ struct Scene {
     double duration;  ///< T [s]
 };
 
+/// The last value of column `name` of a series.csv.
+double lastValue(const std::string& csv, const std::string& name) {
+    std::istringstream in(csv);
+    std::string header, line, last;
+    std::getline(in, header);
+    while (std::getline(in, line))
+        if (!line.empty()) last = line;
+    auto cells = [](const std::string& row) {
+        std::vector<std::string> out;
+        std::stringstream ss(row);
+        for (std::string c; std::getline(ss, c, ',');) out.push_back(c);
+        return out;
+    };
+    const auto h = cells(header), v = cells(last);
+    const auto at = std::find(h.begin(), h.end(), name);
+    if (at == h.end() || static_cast<std::size_t>(at - h.begin()) >= v.size()) {
+        ADD_FAILURE() << "no column " << name;
+        return 0;
+    }
+    return std::stod(v[static_cast<std::size_t>(at - h.begin())]);
+}
+
 class Restart : public Cli {
 protected:
     /// `haet run -q examples/SCENE` with the scene's overrides and `extra`, into out.
@@ -38,11 +62,17 @@ protected:
         return haet(args);
     }
     static std::string duration(double t) { return "duration=" + std::to_string(t); }
+    /// A hybrid run changed modes both ways (or handed grains over by the modified EDM).
+    static void expectModeChanges(const fs::path& dir) {
+        const std::string csv = read(dir / "series.csv");
+        EXPECT_GT(lastValue(csv, "to_tdm"), 0) << dir;
+        EXPECT_GT(lastValue(csv, "to_edm") + lastValue(csv, "tc_handovers"), 0) << dir;
+    }
 
     /// Every output a resumed run must reproduce: series.csv, the collections and every snapshot file, by name.
     static std::vector<std::pair<std::string, std::string>> outputs(const fs::path& dir) {
         std::vector<std::pair<std::string, std::string>> files;
-        static const std::regex re(R"(series\.csv|.*\.pvd|.*_[0-9]{6}\.(vtu|vtp|vti))");
+        static const std::regex re(R"(series\.csv|final\.(csv|data)|.*\.pvd|.*_[0-9]{6}\.(vtu|vtp|vti))");
         for (const auto& e : fs::directory_iterator(dir))
             if (std::regex_match(e.path().filename().string(), re))
                 files.emplace_back(e.path().filename().string(), read(e.path()));
@@ -127,6 +157,33 @@ const Scene kGas2d{"gas2d.toml", {"method=edm", "output.series_period=0.002", "o
 TEST_F(Restart, EdmResumesBitForBit) {
     expectResumeIdentical(kGas, 1, false);
     expectResumeIdentical(kGas2d, 1, false);
+}
+
+// The hybrid: the demo's bed with its stream just above it (grains land and change mode within the run), and the
+// silo of segments with its inlet and outlets (particles born and removed in either mode). The state of every part
+// is saved (haet/state.cpp); the hybrid steps whole time steps whatever the pieces it is called in, so the run to T/2
+// resumed to T matches too. The runs are checked to change modes, or they would not test the books of a change.
+const Scene kHaetDemo{"haet_demo.toml",
+                      {"insert[1].count=250", "insert[2].count=800", "insert[2].region={lo=[0.05,0.016],hi=[0.25,0.05]}",
+                       "contact.duration=4e-4", "output.series_period=0.004", "output.snapshot_period=0.02"},
+                      0.08};
+const Scene kHaetSilo{"silo2d.toml",
+                      {"insert[1].count=800", "inlet[1].end=1", "outlet[1].interval=1e-3", "outlet[2].interval=1e-3",
+                       "output.series_period=0.002", "output.snapshot_period=0.01"},
+                      0.04};
+
+TEST_F(Restart, HybridResumesBitForBit) {
+    for (int threads : {1, 2}) {
+        expectResumeIdentical(kHaetDemo, threads);
+        expectModeChanges(dir_ / "full");
+    }
+}
+
+TEST_F(Restart, HybridWithInletsOutletsAndSegmentsResumesBitForBit) {
+    for (int threads : {1, 2}) {
+        expectResumeIdentical(kHaetSilo, threads);
+        expectModeChanges(dir_ / "full");
+    }
 }
 
 /// The files of a run to T with checkpoints, and a copy of its directory to resume from.
@@ -315,6 +372,16 @@ TEST_F(RestartSignals, StoppedEventDrivenRunResumesToTheSameBytes) {
                "output.checkpoint_period=0.01"},
               1.5};
     expectStoppedRunsResume(40, 200);
+}
+
+// The hybrid stops after the step under way, its event-driven particles each at its own clock.
+TEST_F(RestartSignals, StoppedHybridRunResumesToTheSameBytes) {
+    scene_ = {"haet_demo.toml",
+              {"insert[1].count=250", "insert[2].count=800", "insert[2].region={lo=[0.05,0.016],hi=[0.25,0.05]}",
+               "contact.duration=4e-4", "output.series_period=0.002", "output.snapshot_period=0.02",
+               "output.checkpoint_period=0.01"},
+              0.16};
+    expectStoppedRunsResume(25, 50);
 }
 
 TEST_F(RestartSignals, KillNineLeavesAWholeCheckpointToResumeFrom) {
