@@ -273,6 +273,60 @@ TEST_F(Restart, DurationDefaultsAreNamed) {
         << r.err;
 }
 
+// The files a scenario names are part of it by their contents: a particle file or an STL mesh changed since the
+// checkpoint was written is refused on resume, naming the file (the particles come from the checkpoint, but the
+// scenario is another one). The scene: the tiny drop with its spheres read from the file the run of the tiny scene
+// wrote as its final state, and a floor of two triangles from an STL file.
+TEST_F(Restart, ChangedParticleOrMeshFileIsExitTwoNamingIt) {
+    Result r = haet("run -q '" + std::string(HAET_SOURCE_DIR) + "/examples/drop3d_tiny.toml' --out '" +
+                    (dir_ / "first").string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const fs::path bed = dir_ / "bed.csv";
+    fs::copy_file(dir_ / "first" / "final.csv", bed);
+    auto facet = [](const std::string& a, const std::string& b, const std::string& c) {
+        return " facet normal 0 0 1\n  outer loop\n   vertex " + a + "\n   vertex " + b + "\n   vertex " + c +
+               "\n  endloop\n endfacet\n";
+    };
+    const std::string floor = "solid floor\n" + facet("0 0 0.0002", "0.01 0 0.0002", "0.01 0.01 0.0002") +
+                              facet("0 0 0.0002", "0.01 0.01 0.0002", "0 0.01 0.0002") + "endsolid floor\n";
+    const fs::path stl = write("floor.stl", floor);
+    std::string text = withInsert("arrangement = \"file\"\nfile = \"bed.csv\"\nformat = \"csv\"\nmaterial = \"glass\"\n");
+    text.replace(text.find("[[insert]]"), 0,
+                 "[[walls]]\ntype = \"mesh\"\nfile = \"floor.stl\"\nmaterial = \"glass\"\n\n");
+    const fs::path scene = write("staged.toml", text);
+    const fs::path out = dir_ / "run";
+    auto runIt = [&](bool resume) {
+        return haet("run -q '" + scene.string() + "' " + (resume ? "--resume '" : "--out '") + out.string() +
+                    "' --set duration=" + (resume ? "0.002" : "0.001") + " --set output.checkpoint_period=5e-4");
+    };
+    r = runIt(false);
+    ASSERT_EQ(r.code, 0) << r.err;
+    ASSERT_EQ(runIt(true).code, 0) << "unchanged files resume";
+    // A resume that went on wrote checkpoints of its own: start again from the first run's.
+    fs::remove_all(out);
+    ASSERT_EQ(runIt(false).code, 0);
+
+    std::ofstream(bed, std::ios::app) << "# the same particles, another file\n";
+    r = runIt(true);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find(bed.string() + ": the file of insert[1].file has changed since the checkpoint"),
+              std::string::npos)
+        << r.err;
+
+    fs::copy_file(dir_ / "first" / "final.csv", bed, fs::copy_options::overwrite_existing);
+    ASSERT_EQ(runIt(true).code, 0) << "the file as it was resumes";
+    fs::remove_all(out);
+    ASSERT_EQ(runIt(false).code, 0);
+    std::string moved = floor;
+    moved.replace(moved.find("0 0.01 0.0002"), 13, "0 0.01 0.0003");
+    std::ofstream(stl, std::ios::binary) << moved;
+    r = runIt(true);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find(stl.string() + ": the file of walls[2].file has changed since the checkpoint"),
+              std::string::npos)
+        << r.err;
+}
+
 TEST_F(RestartFaults, NoCheckpointIsExitTwo) {
     const fs::path c = dir_ / "empty";
     fs::create_directories(c);
