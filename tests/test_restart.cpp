@@ -148,6 +148,24 @@ TEST_F(Restart, TdmWithInletsOutletsAndSegmentsResumesBitForBit) {
     for (int threads : {1, 2}) expectResumeIdentical(kSilo, threads);
 }
 
+// Polygons (Gear's integrator, the overlap-area law, their tangential springs in the pair list): a box of hexagons and
+// random convex shapes settling on planes, and a hopper of segment walls (their contacts with walls of any shape).
+const Scene kPolygonBox{"box2d_polygons.toml",
+                        {"insert[1].count=100", "insert[2].count=100", "output.series_period=0.01",
+                         "output.snapshot_period=0.05"},
+                        0.2};
+const Scene kPolygonHopper{"hopper2d_polygons.toml",
+                           {"insert[1].count=300", "output.series_period=0.002", "output.snapshot_period=0.01"},
+                           0.04};
+
+TEST_F(Restart, PolygonsResumeBitForBit) {
+    for (int threads : {1, 2}) {
+        expectResumeIdentical(kPolygonBox, threads);
+        EXPECT_GT(lastValue(read(dir_ / "full" / "series.csv"), "n_contacts"), 50);
+        expectResumeIdentical(kPolygonHopper, threads);
+    }
+}
+
 // Event-driven: a gas in a periodic box (cell crossings, collisions, the TC model's clocks, the re-sorting of the
 // slots), and a 2D gas in a closed box (plane walls).
 const Scene kGas{
