@@ -204,6 +204,75 @@ TEST_F(Restart, HybridWithInletsOutletsAndSegmentsResumesBitForBit) {
     }
 }
 
+// An output directory that cannot be made (a file stands in its way) or written in: exit code 4, the path named.
+TEST_F(Restart, UnwritableOutputIsExitFourNamingThePath) {
+    write("afile", "not a directory");
+    for (const fs::path& out : {dir_ / "afile" / "run", fs::path("/proc/self")}) {
+        const Result r =
+            haet("run -q '" + std::string(HAET_SOURCE_DIR) + "/examples/drop3d_tiny.toml' --out '" + out.string() + "'");
+        EXPECT_EQ(r.code, 4) << r.err;
+        EXPECT_NE(r.err.find("cannot write an output: " + out.string()), std::string::npos) << r.err;
+    }
+}
+
+// A disk that fills up: the run resumed from T/2 may write no file larger than its snapshots (RLIMIT_FSIZE with
+// SIGXFSZ ignored: a write past the limit fails with EFBIG, as one on a full disk with ENOSPC), so its next
+// checkpoint fails. Exit code 4 naming the file; every file left is whole (no temporary file renamed into place,
+// none left behind; the checkpoints before parse, series.csv and the collections are complete, run.json says
+// "failed: output"); resumed on a disk with room, the run writes the bytes of the run that never failed.
+TEST_F(Restart, FullDiskIsExitFourAndLeavesEveryFileWhole) {
+    const Scene& s = kSilo;
+    const std::string period = "output.checkpoint_period=" + std::to_string(s.duration / 4);
+    const fs::path full = dir_ / "full", out = dir_ / "out";
+    Result r = run(s, full, 1, {duration(s.duration), period});
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = run(s, out, 1, {duration(s.duration / 2), period});
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::uintmax_t largest = 0, smallestCheckpoint = ~std::uintmax_t{0};
+    for (const auto& e : fs::directory_iterator(full)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind("checkpoint_", 0) == 0)
+            smallestCheckpoint = std::min(smallestCheckpoint, e.file_size());
+        else if (name.rfind("final", 0) != 0)
+            largest = std::max(largest, e.file_size());
+    }
+    ASSERT_LT(largest, smallestCheckpoint) << "a checkpoint is the largest file the run writes before its end";
+    const auto before = haet::listCheckpoints(out);
+    ASSERT_EQ(before.size(), 2u);
+
+    std::vector<std::string> args = {"run",     "-q",  std::string(HAET_SOURCE_DIR) + "/examples/" + s.file,
+                                     "--threads", "1", "--resume", out.string(), "--set", duration(s.duration),
+                                     "--set",   period};
+    for (const std::string& v : s.sets) args.insert(args.end(), {"--set", v});
+    // First a limit below the checkpoints only, then one below the snapshots too (written through a stream).
+    const fs::path checkpoint =
+        out / haet::checkpointFileName(haet::parseCheckpoint(read(before[0])).header.sequence + 1);
+    for (const auto& [limit, failing] : {std::pair{(largest + smallestCheckpoint) / 2, checkpoint.string()},
+                                         std::pair{largest / 2, (out / "particles_").string()}}) {
+        SCOPED_TRACE("at most " + std::to_string(limit) + " bytes a file");
+        const int code = wait(spawn(args, {}, limit));
+        const std::string err = read(dir_ / "stderr.txt");
+        EXPECT_EQ(code, 4) << err;
+        EXPECT_NE(err.find("cannot write an output: " + failing), std::string::npos) << err;
+        EXPECT_NE(err.find(".tmp."), std::string::npos) << err;  // the temporary file it wrote
+        EXPECT_NE(err.find("File too large"), std::string::npos) << err;
+
+        for (const auto& e : fs::directory_iterator(out))
+            EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path() << " left behind";
+        EXPECT_EQ(haet::listCheckpoints(out), before);
+        for (const fs::path& k : before) EXPECT_NO_THROW(haet::parseCheckpoint(read(k))) << k;
+        EXPECT_GE(checkSeries(out / "series.csv"), 10);
+        EXPECT_GE(checkPvd(out / "particles.pvd"), 3);
+        const std::string json = read(out / "run.json");
+        EXPECT_TRUE(JsonCheck(json).valid()) << json;
+        EXPECT_EQ(jsonString(json, "status").rfind("failed: output: " + failing, 0), 0u) << json;
+    }
+
+    r = run(s, out, 1, {duration(s.duration), period}, out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    expectSameOutputs(full, out);
+}
+
 /// The files of a run to T with checkpoints, and a copy of its directory to resume from.
 class RestartFaults : public Restart {
 protected:
