@@ -150,10 +150,10 @@ TEST_F(Restart, TdmWithInletsOutletsAndSegmentsResumesBitForBit) {
 
 // Polygons (Gear's integrator, the overlap-area law, their tangential springs in the pair list): a box of hexagons and
 // random convex shapes settling on planes, and a hopper of segment walls (their contacts with walls of any shape).
-const Scene kPolygonBox{"box2d_polygons.toml",
-                        {"insert[1].count=100", "insert[2].count=100", "output.series_period=0.01",
-                         "output.snapshot_period=0.05"},
-                        0.2};
+const Scene kPolygonBox{
+    "box2d_polygons.toml",
+    {"insert[1].count=100", "insert[2].count=100", "output.series_period=0.01", "output.snapshot_period=0.05"},
+    0.2};
 const Scene kPolygonHopper{"hopper2d_polygons.toml",
                            {"insert[1].count=300", "output.series_period=0.002", "output.snapshot_period=0.01"},
                            0.04};
@@ -181,10 +181,11 @@ TEST_F(Restart, EdmResumesBitForBit) {
 // silo of segments with its inlet and outlets (particles born and removed in either mode). The state of every part
 // is saved (haet/state.cpp); the hybrid steps whole time steps whatever the pieces it is called in, so the run to T/2
 // resumed to T matches too. The runs are checked to change modes, or they would not test the books of a change.
-const Scene kHaetDemo{"haet_demo.toml",
-                      {"insert[1].count=250", "insert[2].count=800", "insert[2].region={lo=[0.05,0.016],hi=[0.25,0.05]}",
-                       "contact.duration=4e-4", "output.series_period=0.004", "output.snapshot_period=0.02"},
-                      0.08};
+const Scene kHaetDemo{
+    "haet_demo.toml",
+    {"insert[1].count=250", "insert[2].count=800", "insert[2].region={lo=[0.05,0.016],hi=[0.25,0.05]}",
+     "contact.duration=4e-4", "output.series_period=0.004", "output.snapshot_period=0.02"},
+    0.08};
 const Scene kHaetSilo{"silo2d.toml",
                       {"insert[1].count=800", "inlet[1].end=1", "outlet[1].interval=1e-3", "outlet[2].interval=1e-3",
                        "output.series_period=0.002", "output.snapshot_period=0.01"},
@@ -208,8 +209,8 @@ TEST_F(Restart, HybridWithInletsOutletsAndSegmentsResumesBitForBit) {
 TEST_F(Restart, UnwritableOutputIsExitFourNamingThePath) {
     write("afile", "not a directory");
     for (const fs::path& out : {dir_ / "afile" / "run", fs::path("/proc/self")}) {
-        const Result r =
-            haet("run -q '" + std::string(HAET_SOURCE_DIR) + "/examples/drop3d_tiny.toml' --out '" + out.string() + "'");
+        const Result r = haet("run -q '" + std::string(HAET_SOURCE_DIR) + "/examples/drop3d_tiny.toml' --out '" +
+                              out.string() + "'");
         EXPECT_EQ(r.code, 4) << r.err;
         EXPECT_NE(r.err.find("cannot write an output: " + out.string()), std::string::npos) << r.err;
     }
@@ -240,9 +241,10 @@ TEST_F(Restart, FullDiskIsExitFourAndLeavesEveryFileWhole) {
     const auto before = haet::listCheckpoints(out);
     ASSERT_EQ(before.size(), 2u);
 
-    std::vector<std::string> args = {"run",     "-q",  std::string(HAET_SOURCE_DIR) + "/examples/" + s.file,
-                                     "--threads", "1", "--resume", out.string(), "--set", duration(s.duration),
-                                     "--set",   period};
+    std::vector<std::string> args = {"run",        "-q",    std::string(HAET_SOURCE_DIR) + "/examples/" + s.file,
+                                     "--threads",  "1",     "--resume",
+                                     out.string(), "--set", duration(s.duration),
+                                     "--set",      period};
     for (const std::string& v : s.sets) args.insert(args.end(), {"--set", v});
     // First a limit below the checkpoints only, then one below the snapshots too (written through a stream).
     const fs::path checkpoint =
@@ -377,7 +379,8 @@ TEST_F(Restart, ChangedParticleOrMeshFileIsExitTwoNamingIt) {
     const std::string floor = "solid floor\n" + facet("0 0 0.0002", "0.01 0 0.0002", "0.01 0.01 0.0002") +
                               facet("0 0 0.0002", "0.01 0.01 0.0002", "0 0.01 0.0002") + "endsolid floor\n";
     const fs::path stl = write("floor.stl", floor);
-    std::string text = withInsert("arrangement = \"file\"\nfile = \"bed.csv\"\nformat = \"csv\"\nmaterial = \"glass\"\n");
+    std::string text =
+        withInsert("arrangement = \"file\"\nfile = \"bed.csv\"\nformat = \"csv\"\nmaterial = \"glass\"\n");
     text.replace(text.find("[[insert]]"), 0,
                  "[[walls]]\ntype = \"mesh\"\nfile = \"floor.stl\"\nmaterial = \"glass\"\n\n");
     const fs::path scene = write("staged.toml", text);

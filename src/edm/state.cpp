@@ -1,8 +1,8 @@
 // The event-driven engine's state in a checkpoint (EdmEngine::saveState, loadState; ARCHITECTURE.md, "Checkpoints").
 // The neighbour shells are saved with their lists as they are, which a rebuild from the centres would order
-// otherwise. The slots are saved as they are, each particle at its own clock with its pending event: synchronising them first
-// would move every clock to one time, and the events then pending, predicted from the earlier states, would not be
-// the ones a prediction from the synchronised states finds (their last bits differ), so the run would not go on as
+// otherwise. The slots are saved as they are, each particle at its own clock with its pending event: synchronising them
+// first would move every clock to one time, and the events then pending, predicted from the earlier states, would not
+// be the ones a prediction from the synchronised states finds (their last bits differ), so the run would not go on as
 // the one that was never stopped.
 #include <cmath>
 

@@ -86,8 +86,8 @@ void EdmBook<D>::loadState(ByteReader& in, std::size_t first, std::size_t n) {
     in.getVector(guardEntries_);
     in.getVector(tcHandovers_);
     // Every event-driven particle [first, n) in one list, and only those.
-    if (checkLists(in, head_, next_.size(), [&](std::uint32_t k) { return next_[k]; }, "the book's cells") !=
-            n - first ||
+    if (checkLists(
+            in, head_, next_.size(), [&](std::uint32_t k) { return next_[k]; }, "the book's cells") != n - first ||
         (n > first && next_.size() < n))
         in.fail("the book does not list the event-driven particles");
     for (std::size_t k = 0; k < cell_.size(); ++k)
@@ -240,7 +240,8 @@ void HaetEngine<D>::loadState(ByteReader& in, const std::function<void()>& reloa
     in.getVector(binCells_);
     checkBelow(in, binCells_, cells, "the bins' cell list");
     in.getVector(bins_);
-    checkLists(in, binHead_, bins_.size(), [&](std::uint32_t b) { return bins_[b].next; }, "the bins");
+    checkLists(
+        in, binHead_, bins_.size(), [&](std::uint32_t b) { return bins_[b].next; }, "the bins");
     near_ = NearGrid{};
     near_.valid = in.get<std::uint8_t>() != 0;
     if (near_.valid) {
@@ -255,7 +256,8 @@ void HaetEngine<D>::loadState(ByteReader& in, const std::function<void()>& reloa
         if (total > double(in.rest().size())) in.fail("the near grid has more cells than the bytes left hold");
         near_.grid = CellGrid<D>(lo, dims, width, w_.domain.periodic);
         in.getVector(near_.head, static_cast<std::size_t>(near_.grid.count()), "the near grid's cells");
-        checkLists(in, near_.head, bins_.size(), [&](std::uint32_t b) { return bins_[b].nextNear; }, "the near grid");
+        checkLists(
+            in, near_.head, bins_.size(), [&](std::uint32_t b) { return bins_[b].nextNear; }, "the near grid");
     }
     walls_.loadState(in, static_cast<std::uint32_t>(cells));
     in.getVector(watch_);
