@@ -1,7 +1,8 @@
 // Checkpoints of the engines themselves, for what no scenario reaches: the event-driven engine with neighbour
-// shells (edm/shells.hpp; the scenario has no key for them). A run to T and the same run saved at T/2 (the World and
-// the engine, as a checkpoint holds them), taken up by an engine made on a World loaded from those bytes, and run on
-// to T: the same bits in every particle and the same counts of events.
+// shells (edm/shells.hpp; the scenario has no key for them), and a time-driven engine made with another skin than the
+// saved one (as a resumed run's is, when the skin follows from particles an outlet has removed since). A run to T and
+// the same run saved at T/2 (the World and the engine, as a checkpoint holds them), taken up by an engine made on a
+// World loaded from those bytes, and run on to T: the same bits in every particle and the same counts of events.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -9,8 +10,10 @@
 
 #include "edm/engine.hpp"
 #include "io/checkpoint.hpp"
+#include "tdm/engine.hpp"
 #include "test_edm_util.hpp"
 #include "world/state.hpp"
+#include "world_util.hpp"
 
 namespace haet::testing {
 namespace {
@@ -86,6 +89,49 @@ TEST(RestartEngines, ShellsAndCellCrossingsDoNotMix) {
     ea.saveState(saved);
     ByteReader in(saved.bytes(), "ENGN");
     EXPECT_THROW(eb.loadState(in), CheckpointError);
+}
+
+// 64 spheres fall onto a plane and settle; the engine that takes up the saved state was made with a thinner skin.
+TEST(RestartEngines, TdmGoesOnWithTheSavedSkin) {
+    World<3> base;
+    base.domain = openBox<3>(0.05);
+    base.domain.gravity = {0, 0, -9.81};
+    for (int i = 0; i < 64; ++i) {
+        const Vec<3> x{-0.015 + 0.01 * (i % 4), -0.015 + 0.01 * (i / 4 % 4), -0.043 + 0.01 * (i / 16)};
+        base.particles.add(x, Vec<3>::zero(), Ang<3>::zero(), 0.0042 + 0.0001 * (i % 5), 2500, 0, i);
+    }
+    base.walls.push_back(Wall<3>::plane({0, 0, -0.05}, {0, 0, 1}, Vec<3>::zero(), 0));
+    const Scenario sc = linearScenario(3, 0.5, 1e-3, 0.4, TangentialLaw::Spring);
+    base.contact = buildContactSetup<3>(sc, statsOf(base.particles, 1));
+    TdmSettings thick;
+    thick.dt = 2e-5;
+    thick.skin = 8e-4;
+    TdmSettings thin = thick;
+    thin.skin = 2e-4;
+    const double T = 0.1;
+
+    World<3> whole = base, first = base, resumed = base;
+    TdmEngine<3> one(whole, thick);
+    one.advanceTo(T);
+    TdmEngine<3> before(first, thick);
+    before.advanceTo(T / 2);
+    ByteWriter world, engine;
+    saveWorld(world, first);
+    before.saveState(engine);
+    ByteReader w1(world.bytes(), "WRLD");
+    loadWorld(w1, resumed);
+    TdmEngine<3> after(resumed, thin);
+    ByteReader w2(world.bytes(), "WRLD"), e(engine.bytes(), "ENGN");
+    loadWorld(w2, resumed);
+    after.loadState(e);
+    EXPECT_EQ(after.settings().skin, thick.skin);
+    after.advanceTo(T);
+
+    EXPECT_GE(one.forceStats().contacts, 48u);  // settled columns on the plane
+    EXPECT_GT(one.rebuilds(), 3u);
+    EXPECT_EQ(after.rebuilds(), one.rebuilds());
+    EXPECT_TRUE(sameBits<3>(resumed.particles.x, whole.particles.x)) << "positions";
+    EXPECT_TRUE(sameBits<3>(resumed.particles.v, whole.particles.v)) << "velocities";
 }
 
 }  // namespace
