@@ -336,6 +336,16 @@ TEST_F(RestartFaults, LaterFormatIsExitTwo) {
     EXPECT_NE(r.err.find("format version " + std::to_string(haet::kCheckpointVersion + 1)), std::string::npos) << r.err;
 }
 
+TEST_F(RestartFaults, EarlierFormatIsExitTwo) {
+    const fs::path c = copy();
+    for (const fs::path& k : kept_) patch(c / k.filename(), 8, char(haet::kCheckpointVersion - 1));
+    const Result r = resume(c);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("format version " + std::to_string(haet::kCheckpointVersion - 1) + ", older than"),
+              std::string::npos)
+        << r.err;
+}
+
 TEST_F(RestartFaults, AnotherScenarioIsExitTwoNamingTheKey) {
     const fs::path c = copy();
     Result r = resume(c, {"materials.glass.restitution=0.5"});
