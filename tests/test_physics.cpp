@@ -564,6 +564,34 @@ TEST(HertzDamped, WallTableServesBothEngines) {
     EXPECT_NEAR(soft.particles.v[0][2], eWall, 1e-4);
 }
 
+// The time-step rule's contact time covers the wall contacts: large light spheres (r = 3 mm, 100 kg/m^3) against a
+// wall touch for a shorter time than the lightest pair, which pairs the lightest mass with the smallest radius of
+// another, denser material (1 mm, 8000 kg/m^3): (m^2/R)^(1/5) of the wall contact is the smaller (B.3).
+TEST(HertzDamped, ContactTimeCountsWallContacts) {
+    ContactModelDef cd;
+    cd.normal = NormalLaw::Hertz;
+    cd.hertzDamping = HertzDamping::None;
+    cd.tangential = TangentialLaw::None;
+    MaterialProps m;
+    m.young = 1e7;
+    m.poisson = 0.3;
+    auto stat = [](double r, double density) {
+        MaterialStats st;
+        st.count = 1;
+        st.meanRadius = st.minRadius = r;
+        st.meanMass = st.minMass = density * 4.0 / 3.0 * kPi * r * r * r;
+        return st;
+    };
+    const std::vector<MaterialStats> stats{stat(1e-3, 8000), stat(3e-3, 100)};
+    const ContactSetup s = buildContactSetup<3>(cd, {m, m}, stats, {true, true}, {false, true});
+    const double eEff = m.young / (2 * (1 - m.poisson * m.poisson)), mb = stats[1].minMass;
+    const double wall = 2.868 * std::pow(mb * mb / (3e-3 * eEff * eEff * cd.impactVelocity), 0.2);
+    const double pair = 2.868 * std::pow(0.25 * mb * mb / (0.5e-3 * eEff * eEff * cd.impactVelocity), 0.2);
+    ASSERT_LT(wall, pair);
+    EXPECT_NEAR(s.contactTime, wall, 1e-12 * wall);
+    EXPECT_NE(s.contactTimeNote.find("a wall contact"), std::string::npos) << s.contactTimeNote;
+}
+
 // ------------------------------------------------------------------------------------------------------------
 // 4. Settling in a closed box
 // ------------------------------------------------------------------------------------------------------------
