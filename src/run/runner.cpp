@@ -9,6 +9,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -27,6 +28,7 @@
 #include "run/checkpoint.hpp"
 #include "run/export.hpp"
 #include "run/flow.hpp"
+#include "run/measures.hpp"
 #include "run/picture.hpp"
 #include "run/progress.hpp"
 #include "run/run_dir.hpp"
@@ -108,6 +110,11 @@ public:
     /// Before a checkpoint: the World as it must be saved, without changing what the engine computes next (an
     /// event-driven engine holding the positions gives them back as they are, unsynchronised).
     virtual void exposeState() {}
+    /// The measurements' hooks (run/measures.hpp): the contacts of the force pass at time t into *sink, the time of
+    /// the last pass that recorded them (-1: none), every event-driven collision.
+    virtual void recordContactsAt(ContactSink<D>*, double) {}
+    virtual double contactsRecordedAt() const { return -1; }
+    virtual void setCollisionHook(std::function<void(const EdmCollision<D>&)>) {}
 };
 
 /// The driver's loadState for one engine: the World's particles again (making the engine may have sorted them or
@@ -157,6 +164,8 @@ public:
     bool restartable() const override { return true; }
     void saveState(ByteWriter& out) const override { eng_.saveState(out); }
     void loadState(const CheckpointFile& f) override { loadEngineState(f, w_, eng_); }
+    void recordContactsAt(ContactSink<D>* s, double t) override { eng_.recordContactsAt(s, t); }
+    double contactsRecordedAt() const override { return eng_.contactsRecordedAt(); }
 
 private:
     World<D>& w_;
@@ -205,6 +214,7 @@ public:
     void exposeState() override { eng_.exposeHeldState(); }
     void saveState(ByteWriter& out) const override { eng_.saveState(out); }
     void loadState(const CheckpointFile& f) override { loadEngineState(f, w_, eng_); }
+    void setCollisionHook(std::function<void(const EdmCollision<D>&)> f) override { eng_.setObserver(std::move(f)); }
 
 private:
     World<D>& w_;
@@ -272,6 +282,11 @@ public:
     std::size_t eager() const override { return eng_.nTdm(); }
     void remove(const std::vector<std::uint32_t>& which) override { eng_.removeParticles(which); }
     void added(std::size_t first) override { eng_.addParticles(first); }
+    void recordContactsAt(ContactSink<D>* s, double t) override { eng_.recordContactsAt(s, t); }
+    double contactsRecordedAt() const override { return eng_.tdm().contactsRecordedAt(); }
+    void setCollisionHook(std::function<void(const EdmCollision<D>&)> f) override {
+        eng_.setCollisionHook(std::move(f));
+    }
 
 private:
     HaetEngine<D> eng_;
@@ -507,6 +522,11 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         flow.loadState(in);
     }
     for (auto& c : flow.columns()) columns.push_back(c);
+    // Fields, stress tensors, the contact network (run/measures.hpp), fed by the engine's hooks.
+    Measures<D> measures(sc, world, dir, plan.snapshotPeriod);
+    for (auto& c : measures.columns()) columns.push_back(c);
+    eng->setCollisionHook([&measures](const EdmCollision<D>& c) { measures.collision(c); });
+    auto contactsNow = [&] { return measures.wantsContacts() && eng->contactsRecordedAt() == world.time; };
     double lastRowTime = world.time;
     auto rowValues = [&](double stamp) {
         const Energies<D> e = energies(world);
@@ -529,6 +549,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                                                   pressure};
         for (auto& v : eng->extraRow()) row.push_back(v);
         for (auto& v : flow.row(world.time)) row.push_back(v);
+        for (auto& v : measures.row(world, contactsNow(), window)) row.push_back(v);
         return row;
     };
 
@@ -626,6 +647,9 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         const SeriesMark mark = loadSeriesMark(in);
         snaps.loadState(in);
         in.expectEnd();
+        ByteReader meas = resume->file.section("MEAS");
+        measures.loadState(meas);
+        meas.expectEnd();
         series.resume(seriesAtCheckpoint(std::move(savedSeries), mark, series.path(), resume->path), mark.rows);
         if (lastRow >= 0) rows.pass(lastRow, eps);
         if (lastShot >= 0) shots.pass(lastShot, eps);
@@ -641,6 +665,7 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
     auto shot = [&](double stamp) {
         eng->synchronise();
         snaps.write(world, stamp, eng->hybrid());
+        measures.snapshot(world, stamp, contactsNow());
         series.flush();
         lastShot = world.time;
     };
@@ -667,6 +692,9 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         body.endSection();
         body.beginSection("FLOW");
         flow.saveState(body);
+        body.endSection();
+        body.beginSection("MEAS");
+        measures.saveState(body);
         body.endSection();
         body.beginSection("RUN ");
         body.put<std::uint64_t>(sequence + 1);
@@ -701,13 +729,20 @@ RunStatus runWorld(const Scenario& sc, const RunOptions& opt, std::ostream& log)
                 shot(OutputClock::stamp(world.time, shots.next()));
                 shots.pass(world.time, eps);
             }
+            if (measures.nextTime() <= world.time + eps) {
+                eng->synchronise();
+                measures.sample(world, contactsNow(), eps);
+            }
             if (ckpts.due(world.time, eps)) {
                 if (lastCheckpoint != world.time) checkpoint();
                 ckpts.pass(world.time, eps);
             }
             if (world.time + eps >= sc.duration || signals.requested()) break;
             // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
-            const double target = std::min({sc.duration, rows.next(), shots.next(), ckpts.next(), flow.nextTime()});
+            const double target =
+                std::min({sc.duration, rows.next(), shots.next(), ckpts.next(), flow.nextTime(), measures.nextTime()});
+            // The force pass that ends at the next output records its contacts for the measurements.
+            if (measures.wantsContacts()) eng->recordContactsAt(measures.sink(), target);
             while (chunks.due(world.time, eps)) chunks.pass(world.time, eps);
             eng->advanceTo(chunks.next() < target - eps ? chunks.next() : target);
             if (world.time + eps >= flow.nextTime()) flow.act(world, *eng, eps);
