@@ -37,8 +37,15 @@ echo "soak: $(basename "$SCENE"), $STEPS steps of $dt s = $duration s simulated,
     --set "output.snapshot_period=$(python3 -c "print(repr($duration / 10))")" \
     --out "$dir/run" --threads 1 --quiet &
 pid=$!
-sleep 0.2
-child=$(pgrep -P "$pid" -x haet || echo "$pid")
+# /usr/bin/time's child is the run (named "exe" once it has re-executed itself with its OpenMP settings): wait
+# until it has been started.
+child=""
+for _ in $(seq 1 100); do
+    child=$(pgrep -P "$pid" | head -n 1 || true)
+    [ -n "$child" ] && break
+    sleep 0.1
+done
+[ -n "$child" ] || { echo "soak: the run did not start" >&2; exit 1; }
 echo "wall_s,rss_bytes" >"$dir/rss.csv"
 start=$(date +%s.%N)
 while kill -0 "$pid" 2>/dev/null; do

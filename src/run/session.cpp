@@ -1,0 +1,433 @@
+#include "run/session.hpp"
+
+#include <fmt/format.h>
+#include <omp.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <optional>
+#include <ostream>
+
+#include "core/version.hpp"
+#include "io/atomic_file.hpp"
+#include "io/checkpoint.hpp"
+#include "io/json.hpp"
+#include "io/series.hpp"
+#include "run/checkpoint.hpp"
+#include "run/drivers.hpp"
+#include "run/export.hpp"
+#include "run/flow.hpp"
+#include "run/measures.hpp"
+#include "run/progress.hpp"
+#include "run/run_dir.hpp"
+#include "run/schedule.hpp"
+#include "run/snapshots.hpp"
+#include "run/stop.hpp"
+
+namespace haet {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::size_t peakRssBytes() {
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    return static_cast<std::size_t>(ru.ru_maxrss) * 1024;
+}
+
+std::filesystem::path runDirectory(const Scenario& sc, const RunOptions& opt) {
+    if (!opt.resumeDir.empty()) return opt.resumeDir;
+    return opt.outDir.empty() ? std::filesystem::path(sc.output.directory) : opt.outDir;
+}
+
+template <int D>
+class Session final : public RunSession {
+public:
+    Session(const Scenario& sc, const RunOptions& opt, std::ostream& log)
+        : sc_(sc), opt_(opt), log_(log), t0_(Clock::now()), dir_(runDirectory(sc_, opt_)) {
+        // A resumed run starts from the newest whole checkpoint of its directory: the World built from the
+        // scenario (box, walls, contact table) takes the saved particles, the engine is made on them and takes its
+        // own state.
+        if (!opt_.resumeDir.empty()) resume_ = findCheckpoint(dir_, sc_, log_);
+        world_.emplace(buildWorld<D>(sc_));
+        World<D>& world = *world_;
+        if (resume_) {
+            ByteReader in = resume_->file.section("WRLD");
+            loadWorld(in, world);
+            in.expectEnd();
+        }
+        eng_ = makeDriver<D>(sc_, world, signals_.flag());
+        if (resume_) {
+            if (!eng_->restartable())
+                throw std::invalid_argument(std::string("--resume: runs of method \"") + eng_->method() +
+                                            "\" cannot be resumed yet");
+            eng_->loadState(resume_->file);
+        }
+        plan_ = planRun(sc_, eng_->dt(), world.contact.contactTime);
+        for (const auto& [key, what] : plan_.warnings) log_ << "warning: " << key << ": " << what << "\n";
+
+        if (!resume_) prepareRunDirectory(dir_);
+        std::vector<std::string> columns = {
+            "time",         "step",        "kinetic_energy", "rotational_energy", "potential_energy", "elastic_energy",
+            "total_energy", "n_particles", "n_contacts",     "max_overlap_ratio", "pressure"};
+        for (auto& c : eng_->extraColumns()) columns.push_back(c);
+        flow_.emplace(sc_, world, eng_->stepTime());
+        if (resume_) {
+            ByteReader in = resume_->file.section("FLOW");
+            flow_->loadState(in);
+        }
+        for (auto& c : flow_->columns()) columns.push_back(c);
+        // Fields, stress tensors, the contact network (run/measures.hpp), fed by the engine's hooks.
+        measures_.emplace(sc_, world, dir_, plan_.snapshotPeriod);
+        for (auto& c : measures_->columns()) columns.push_back(c);
+        eng_->setCollisionHook([this](const EdmCollision<D>& c) { measures_->collision(c); });
+        lastRowTime_ = world.time;
+        // A resumed run's series.csv as the stopped run left it, read before it is rewritten.
+        std::string savedSeries = resume_ ? readFileText(dir_ / "series.csv") : std::string();
+        // A run killed before its end (kill -9, a node lost) leaves run.json saying so; it also proves the
+        // directory writable before any time is spent.
+        writeRunJson("running");
+        series_.emplace(dir_ / "series.csv", columns);
+        snaps_.emplace(dir_);
+
+        const bool tty = opt_.progress == ProgressDisplay::On ||
+                         (opt_.progress == ProgressDisplay::Auto && !opt_.quiet && isatty(STDERR_FILENO));
+        progress_.emplace(tty, sc_.duration);
+        eps_ = eng_->timeTolerance();
+        rows_ = OutputClock(plan_.seriesPeriod);
+        shots_ = OutputClock(plan_.snapshotPeriod);
+        ckpts_ = OutputClock(sc_.output.checkpointPeriod);
+        // The engine is called in the same pieces whether or not the progress line shows (an event-driven
+        // engine's state depends on where its calls end): up to every output time and every 1/500 of the run, at
+        // which the progress line may update (at most every 200 ms).
+        chunks_ = OutputClock(sc_.duration / 500);
+        if (resume_) {
+            // The outputs as they were when the checkpoint was written: series.csv up to its rows (a stopped run's
+            // last-state row after it is not the schedule's), the collections' entries; the clocks from the times
+            // of the last outputs, so that periods changed on resume take effect from here.
+            ByteReader in = resume_->file.section("RUN ");
+            sequence_ = in.get<std::uint64_t>();
+            lastRow_ = in.get<double>();
+            lastShot_ = in.get<double>();
+            lastRowTime_ = in.get<double>();
+            const SeriesMark mark = loadSeriesMark(in);
+            snaps_->loadState(in);
+            in.expectEnd();
+            ByteReader meas = resume_->file.section("MEAS");
+            measures_->loadState(meas);
+            meas.expectEnd();
+            series_->resume(seriesAtCheckpoint(std::move(savedSeries), mark, series_->path(), resume_->path),
+                            mark.rows);
+            if (lastRow_ >= 0) rows_.pass(lastRow_, eps_);
+            if (lastShot_ >= 0) shots_.pass(lastShot_, eps_);
+            ckpts_.pass(world.time, eps_);
+            lastCheckpoint_ = world.time;
+            log_ << "resuming from " << resume_->path.string() << " at t = " << world.time << " s\n";
+        }
+        checkpoints_ = eng_->restartable();
+        if (!checkpoints_ && sc_.output.checkpointPeriod > 0)
+            log_ << "warning: output.checkpoint_period: runs of method \"" << eng_->method()
+                 << "\" write no checkpoints yet\n";
+    }
+
+    bool advance(double until) override {
+        if (stopped_ || finished_) return false;
+        World<D>& world = *world_;
+        try {
+            for (;;) {
+                if (rows_.due(world.time, eps_)) {
+                    row(OutputClock::stamp(world.time, rows_.next()));
+                    rows_.pass(world.time, eps_);
+                }
+                if (shots_.due(world.time, eps_)) {
+                    shot(OutputClock::stamp(world.time, shots_.next()));
+                    shots_.pass(world.time, eps_);
+                }
+                if (measures_->nextTime() <= world.time + eps_) {
+                    eng_->synchronise();
+                    measures_->sample(world, contactsNow(), eps_);
+                }
+                if (ckpts_.due(world.time, eps_)) {
+                    if (lastCheckpoint_ != world.time) checkpoint();
+                    ckpts_.pass(world.time, eps_);
+                }
+                if (world.time + eps_ >= until || signals_.requested()) break;
+                // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
+                const double target = std::min(
+                    {until, rows_.next(), shots_.next(), ckpts_.next(), flow_->nextTime(), measures_->nextTime()});
+                // The force pass that ends at the next output records its contacts for the measurements.
+                if (measures_->wantsContacts()) eng_->recordContactsAt(measures_->sink(), target);
+                while (chunks_.due(world.time, eps_)) chunks_.pass(world.time, eps_);
+                eng_->advanceTo(chunks_.next() < target - eps_ ? chunks_.next() : target);
+                if (world.time + eps_ >= flow_->nextTime()) flow_->act(world, *eng_, eps_);
+                progress_->update(world.time, eng_->steps(), eng_->contacts());
+            }
+        } catch (const SimulationError& e) {
+            progress_->finish();
+            log_ << "error: simulation stopped: " << e.what() << "\n";
+            status_ = RunStatus::BlewUp;
+            statusText_ = std::string("failed: ") + e.what();
+            stopped_ = true;
+        } catch (const IoError& e) {
+            // Disk full, directory gone: every file on disk is still a whole one (atomic writes); say so in
+            // run.json if that still can be written.
+            progress_->finish();
+            stopped_ = true;
+            try {
+                writeRunJson(std::string("failed: output: ") + e.what());
+            } catch (const IoError&) {
+            }
+            throw;
+        }
+        if (signals_.requested()) stopped_ = true;
+        return !stopped_;
+    }
+
+    RunStatus finish() override {
+        if (finished_) return status_;
+        finished_ = true;
+        World<D>& world = *world_;
+        if (signals_.requested() && status_ != RunStatus::BlewUp) {
+            status_ = signals_.signal() == SIGINT ? RunStatus::Interrupted : RunStatus::Terminated;
+            statusText_ = "interrupted";
+            log_ << (signals_.signal() == SIGINT ? "\nSIGINT" : "\nSIGTERM") << ": stopped at t = " << world.time
+                 << " s; writing the last state\n";
+        }
+        // The last state, always: a checkpoint (before the last row and snapshot, which are not the schedule's: a
+        // resumed run drops them), then a row and a snapshot at the time the run ended, unless the schedule just
+        // wrote them. A blown-up state is not checkpointed: the last checkpoint stays the newest.
+        try {
+            if (status_ != RunStatus::BlewUp && lastCheckpoint_ != world.time) checkpoint();
+            if (lastRow_ != world.time) row(OutputClock::stamp(world.time, sc_.duration));
+            if (lastShot_ != world.time) shot(OutputClock::stamp(world.time, sc_.duration));
+        } catch (const SimulationError& e) {  // a blown-up state the engine cannot bring to one time
+            log_ << "error: the last state cannot be written: " << e.what() << "\n";
+        }
+        progress_->update(world.time, eng_->steps(), eng_->contacts(), true);
+        progress_->finish();
+        series_->flush();
+        // The state for a next stage (run/export.hpp): disks and spheres, unless the run blew up.
+        if (status_ != RunStatus::BlewUp && !world.particles.hasPolygons() && world.particles.hasMotion()) {
+            writeStateCsv(dir_ / "final.csv", world, sc_.materials);
+            writeLammpsData(dir_ / "final.data", world, sc_.materials);
+        }
+        writeRunJson(statusText_);
+        writeFinalPicture(sc_, world, eng_->hybrid(), dir_ / "final.png");
+        if (!opt_.quiet) {
+            const double wall = std::chrono::duration<double>(Clock::now() - t0_).count();
+            log_ << fmt::format("{} ({}): {} particles, simulated {:.4g} s in {:.2f} s wall time; outputs in {}\n",
+                                sc_.name, eng_->method(), world.particles.size(), world.time, wall, dir_.string());
+        }
+        return status_;
+    }
+
+    double time() const override { return world_->time; }
+    std::uint64_t steps() const override { return eng_->steps(); }
+    RunStatus status() const override { return status_; }
+    const Scenario& scenario() const override { return sc_; }
+    void synchronise() override { eng_->synchronise(); }
+
+protected:
+    World<2>* world2() override {
+        if constexpr (D == 2) return &*world_;
+        return nullptr;
+    }
+    World<3>* world3() override {
+        if constexpr (D == 3) return &*world_;
+        return nullptr;
+    }
+
+private:
+    std::vector<std::optional<double>> rowValues(double stamp) {
+        const World<D>& world = *world_;
+        const Energies<D> e = energies(world);
+        const double elastic = eng_->elasticEnergy();
+        const double window = world.time - lastRowTime_;
+        lastRowTime_ = world.time;
+        std::optional<double> pressure;
+        const double vir = eng_->virial(window);
+        if (world.domain.fullyPeriodic()) pressure = (e.mv2 + vir) / (D * world.domain.volume());
+        std::vector<std::optional<double>> row = {stamp,
+                                                  double(eng_->steps()),
+                                                  e.kinetic,
+                                                  e.rotational,
+                                                  e.potential,
+                                                  elastic,
+                                                  e.kinetic + e.rotational + e.potential + elastic,
+                                                  double(world.particles.size()),
+                                                  double(eng_->contacts()),
+                                                  eng_->maxOverlapRatio(),
+                                                  pressure};
+        for (auto& v : eng_->extraRow()) row.push_back(v);
+        for (auto& v : flow_->row(world.time)) row.push_back(v);
+        for (auto& v : measures_->row(world, contactsNow(), window)) row.push_back(v);
+        return row;
+    }
+
+    /// Whether the force pass at the current time recorded its contacts (the measurements read them).
+    bool contactsNow() const { return measures_->wantsContacts() && eng_->contactsRecordedAt() == world_->time; }
+
+    void row(double stamp) {
+        eng_->synchronise();
+        series_->row(rowValues(stamp));
+        lastRow_ = world_->time;
+    }
+
+    void shot(double stamp) {
+        eng_->synchronise();
+        snaps_->write(*world_, stamp, eng_->hybrid());
+        measures_->snapshot(*world_, stamp, contactsNow());
+        series_->flush();
+        lastShot_ = world_->time;
+    }
+
+    /// A checkpoint: the whole state at world.time and the outputs written so far (series.csv flushed first, so
+    /// that the file on disk always holds at least the rows a checkpoint counts).
+    void checkpoint() {
+        if (!checkpoints_) return;
+        const World<D>& world = *world_;
+        const auto start = Clock::now();
+        eng_->exposeState();
+        series_->flush();
+        ByteWriter body;
+        body.beginSection("SCEN");
+        body.putString(sc_.stateKeys);
+        body.endSection();
+        body.beginSection("WRLD");
+        saveWorld(body, world);
+        body.endSection();
+        body.beginSection("ENGN");
+        eng_->saveState(body);
+        body.endSection();
+        body.beginSection("FLOW");
+        flow_->saveState(body);
+        body.endSection();
+        body.beginSection("MEAS");
+        measures_->saveState(body);
+        body.endSection();
+        body.beginSection("RUN ");
+        body.put<std::uint64_t>(sequence_ + 1);
+        body.put<double>(lastRow_);
+        body.put<double>(lastShot_);
+        body.put<double>(lastRowTime_);
+        saveSeriesMark(body, *series_);
+        snaps_->saveState(body);
+        body.endSection();
+        CheckpointHeader h;
+        h.dimension = D;
+        h.method = eng_->method();
+        h.scenarioHash = sc_.stateHash;
+        h.time = world.time;
+        h.sequence = ++sequence_;
+        const std::string file = encodeCheckpoint(h, body.bytes());
+        writeCheckpoint(dir_, sequence_, file);
+        lastCheckpoint_ = world.time;
+        ckptBook_.written += 1;
+        ckptBook_.bytes = file.size();
+        ckptBook_.seconds += std::chrono::duration<double>(Clock::now() - start).count();
+    }
+
+    void writeRunJson(const std::string& status) {
+        const World<D>& world = *world_;
+        const double wall = std::chrono::duration<double>(Clock::now() - t0_).count();
+        JsonObject j;
+        j.add("version", kVersion);
+        j.add("scenario", sc_.path);
+        j.add("scenario_name", sc_.name);
+        j.add("scenario_hash", sc_.hash);
+        if (!sc_.overrides.empty()) {  // --set KEY=VALUE, applied to the file in this order
+            JsonObject o;
+            for (const std::string& kv : sc_.overrides) o.add(kv.substr(0, kv.find('=')), kv.substr(kv.find('=') + 1));
+            j.add("overrides", o);
+        }
+        j.add("method", eng_->method());
+        if (resume_) {  // the checkpoint this run went on from
+            j.add("resumed_from", resume_->path.filename().string());
+            j.add("resumed_at", resume_->file.header.time);
+        }
+        j.add("dimension", static_cast<std::int64_t>(D));
+        {  // what `haet render` needs besides the snapshots: the box, the materials' names, the picture's settings
+            const PictureBox box = pictureBox(world);
+            JsonObject d, pic;
+            d.add("lo", std::vector<double>(box.lo.begin(), box.lo.begin() + D));
+            d.add("hi", std::vector<double>(box.hi.begin(), box.hi.begin() + D));
+            d.add("gravity", std::vector<double>(box.gravity.begin(), box.gravity.begin() + D));
+            j.add("domain", d);
+            j.add("materials", materialNames(sc_));
+            const PictureOptions po = pictureOptions(sc_);
+            pic.add("color_by", po.colorBy);
+            if (po.range) pic.add("color_range", std::vector<double>(po.range->begin(), po.range->end()));
+            pic.add("view", std::vector<double>(po.view.begin(), po.view.end()));
+            pic.add("width", static_cast<std::int64_t>(po.widthPx));
+            j.add("picture", pic);
+        }
+        j.add("status", status);
+        j.add("n_particles", world.particles.size());
+        j.add("contact_time", world.contact.contactTime);
+        j.add("simulated_time", world.time);
+        j.add("steps", eng_->steps());
+        eng_->describe(j);
+        flow_->describe(j);
+        if (!plan_.warnings.empty()) {  // what the run warned of on stderr, by the key concerned
+            JsonObject w;
+            for (const auto& [key, what] : plan_.warnings) w.add(key, what);
+            j.add("warnings", w);
+        }
+        if (ckptBook_.written > 0) {  // what the checkpoints of this run cost: their count, last size, time
+            JsonObject c;
+            c.add("written", ckptBook_.written);
+            c.add("last_bytes", ckptBook_.bytes);
+            c.add("seconds", ckptBook_.seconds);
+            j.add("checkpoints", c);
+        }
+        j.add("wall_time", wall);
+        j.add("particle_steps_per_second", wall > 0 ? double(eng_->steps()) * world.particles.size() / wall : 0.0);
+        j.add("threads", static_cast<std::int64_t>(omp_get_max_threads()));
+        j.add("peak_rss_bytes", peakRssBytes());
+        writeFileAtomic(dir_ / "run.json", j.dump() + "\n");
+    }
+
+    // Declared in the order they are made: the scenario is a copy, so that a session outlives its caller's.
+    const Scenario sc_;
+    const RunOptions opt_;
+    std::ostream& log_;
+    const Clock::time_point t0_;
+    const std::filesystem::path dir_;
+    std::optional<ResumePoint> resume_;
+    std::optional<World<D>> world_;
+    StopSignals signals_;
+    std::unique_ptr<Driver<D>> eng_;
+    RunPlan plan_;
+    std::optional<Flow<D>> flow_;
+    std::optional<SeriesWriter> series_;
+    std::optional<SnapshotWriter<D>> snaps_;
+    std::optional<Measures<D>> measures_;
+    std::optional<Progress> progress_;
+    double eps_ = 0;
+    OutputClock rows_{0}, shots_{0}, ckpts_{0}, chunks_{0};
+    double lastRowTime_ = 0;               // engine time of the last row's window start [s]
+    double lastRow_ = -1, lastShot_ = -1;  // engine times of the last row and snapshot written
+    double lastCheckpoint_ = -1;           // engine time of the last checkpoint
+    std::uint64_t sequence_ = 0;           // of the last checkpoint written
+    bool checkpoints_ = false;
+    struct {
+        std::uint64_t written = 0, bytes = 0;
+        double seconds = 0;  // wall time spent making and writing them [s]
+    } ckptBook_;
+    RunStatus status_ = RunStatus::Completed;
+    std::string statusText_ = "completed";
+    bool stopped_ = false, finished_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<RunSession> RunSession::open(const Scenario& sc, const RunOptions& opt, std::ostream& log) {
+    if (opt.threads > 0) omp_set_num_threads(opt.threads);
+    if (sc.dimension == 2) return std::make_unique<Session<2>>(sc, opt, log);
+    return std::make_unique<Session<3>>(sc, opt, log);
+}
+
+}  // namespace haet
