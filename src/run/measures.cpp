@@ -132,7 +132,9 @@ Measures<D>::Measures(const Scenario& sc, const World<D>& w, std::filesystem::pa
         const double period = d.period > 0 ? d.period : (snapshotPeriod > 0 ? snapshotPeriod : sc.duration / 20);
         auto g = std::make_unique<Grid>(d, spec, period, dir_);
         g->startAt(w.time, 0);
-        if (d.fields & ((1u << 5) | (1u << 7))) wantContacts_ = true;  // contact_stress, stress
+        const bool contacts = d.fields & ((1u << 5) | (1u << 7));  // contact_stress, stress
+        gridContacts_.push_back(contacts);
+        wantContacts_ = wantContacts_ || contacts;
         grids_.push_back(std::move(g));
     }
     if (stress_) {
@@ -191,6 +193,16 @@ template <int D>
 double Measures<D>::nextTime() const {
     double t = std::numeric_limits<double>::infinity();
     for (const auto& g : grids_) t = std::min(t, g->next());
+    return t;
+}
+
+template <int D>
+double Measures<D>::contactsWantedAt(double nextRow, double nextShot) const {
+    double t = std::numeric_limits<double>::infinity();
+    for (std::size_t g = 0; g < grids_.size(); ++g)
+        if (gridContacts_[g]) t = std::min(t, grids_[g]->next());
+    if (stress_) t = std::min(t, nextRow);
+    if (contactsOut_) t = std::min(t, nextShot);
     return t;
 }
 

@@ -36,6 +36,9 @@ public:
     /// Whether anything reads the force pass's contacts: then the engine records them at the times asked for.
     bool wantsContacts() const { return wantContacts_; }
     ContactSink<D>* sink() { return &sink_; }
+    /// The next time the measurements read the contacts [s] (infinity: never): the next field sample that takes
+    /// them, the next row (nextRow, with the series' stress), the next snapshot (nextShot, with the contact network).
+    double contactsWantedAt(double nextRow, double nextShot) const;
     /// The next time a field grid samples [s] (infinity: none).
     double nextTime() const;
     /// The field samples due at world.time (within eps), and the outputs whose window ends there.
@@ -57,6 +60,7 @@ private:
     bool stress_;
     bool contactsOut_;
     bool wantContacts_ = false;
+    std::vector<bool> gridContacts_;  ///< per grid: whether it has contact stress
     std::vector<std::unique_ptr<Grid>> grids_;
     std::vector<std::string> regionNames_;  ///< "" for the domain
     std::vector<CgGrid<D>> regions_;        ///< the domain, then the [[regions]]: boxes of one cell

@@ -158,8 +158,9 @@ public:
                 // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
                 const double target = std::min(
                     {until, rows_.next(), shots_.next(), ckpts_.next(), flow_->nextTime(), measures_->nextTime()});
-                // The force pass that ends at the next output records its contacts for the measurements.
-                if (measures_->wantsContacts()) eng_->recordContactsAt(measures_->sink(), target);
+                // The force pass at the next time the measurements read them records its contacts.
+                if (measures_->wantsContacts())
+                    eng_->recordContactsAt(measures_->sink(), measures_->contactsWantedAt(rows_.next(), shots_.next()));
                 while (chunks_.due(world.time, eps_)) chunks_.pass(world.time, eps_);
                 eng_->advanceTo(chunks_.next() < target - eps_ ? chunks_.next() : target);
                 if (world.time + eps_ >= flow_->nextTime()) flow_->act(world, *eng_, eps_);
