@@ -37,8 +37,9 @@ public:
     bool wantsContacts() const { return wantContacts_; }
     ContactSink<D>* sink() { return &sink_; }
     /// The next time the measurements read the contacts [s] (infinity: never): the next field sample that takes
-    /// them, the next row (nextRow, with the series' stress), the next snapshot (nextShot, with the contact network).
-    double contactsWantedAt(double nextRow, double nextShot) const;
+    /// them, the next row (nextRow, with the series' stress), the next snapshot (nextShot, with the contact network),
+    /// the end of the engine's advance (end: the last state's row and snapshot may follow it).
+    double contactsWantedAt(double nextRow, double nextShot, double end) const;
     /// The next time a field grid samples [s] (infinity: none).
     double nextTime() const;
     /// The field samples due at world.time (within eps), and the outputs whose window ends there.

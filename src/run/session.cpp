@@ -160,7 +160,8 @@ public:
                     {until, rows_.next(), shots_.next(), ckpts_.next(), flow_->nextTime(), measures_->nextTime()});
                 // The force pass at the next time the measurements read them records its contacts.
                 if (measures_->wantsContacts())
-                    eng_->recordContactsAt(measures_->sink(), measures_->contactsWantedAt(rows_.next(), shots_.next()));
+                    eng_->recordContactsAt(measures_->sink(),
+                                           measures_->contactsWantedAt(rows_.next(), shots_.next(), until));
                 while (chunks_.due(world.time, eps_)) chunks_.pass(world.time, eps_);
                 eng_->advanceTo(chunks_.next() < target - eps_ ? chunks_.next() : target);
                 if (world.time + eps_ >= flow_->nextTime()) flow_->act(world, *eng_, eps_);
