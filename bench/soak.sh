@@ -32,10 +32,11 @@ rm -rf "$dir.probe"
 duration=$(python3 -c "print(repr($STEPS * $dt))")
 echo "soak: $(basename "$SCENE"), $STEPS steps of $dt s = $duration s simulated, one thread"
 
+# The periods first: the background command's only child must be the run.
+rows=$(python3 -c "print(repr($duration / 500))")
+shots=$(python3 -c "print(repr($duration / 10))")
 /usr/bin/time -f "%U %S %e" -o "$dir.time" "$haet" run "$SCENE" --set "duration=$duration" \
-    --set "output.series_period=$(python3 -c "print(repr($duration / 500))")" \
-    --set "output.snapshot_period=$(python3 -c "print(repr($duration / 10))")" \
-    --out "$dir/run" --threads 1 --quiet &
+    --set "output.series_period=$rows" --set "output.snapshot_period=$shots" --out "$dir/run" --threads 1 --quiet &
 pid=$!
 # /usr/bin/time's child is the run (named "exe" once it has re-executed itself with its OpenMP settings): wait
 # until it has been started.
