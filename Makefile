@@ -2,7 +2,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc)
 DEB_PACKAGES = cmake g++ make pkg-config libgtest-dev libbenchmark-dev libtomlplusplus-dev libcli11-dev \
-               libfmt-dev libcairo2-dev libpng-dev nlohmann-json3-dev zlib1g-dev clang-format python3
+               libfmt-dev libcairo2-dev libpng-dev nlohmann-json3-dev zlib1g-dev clang-format python3 python3-matplotlib
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 .PHONY: all deps build test validate demo bench clean

@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "csv_util.hpp"
 #include "haet/engine.hpp"
 #include "run/flow.hpp"
 #include "run/runner.hpp"
@@ -369,17 +370,7 @@ TEST(Outlet, RemovesExactlyTheParticlesThatCrossIt) {
     for (const std::uint64_t id : w.particles.id) EXPECT_EQ(host.removed.count(id), 0u);
 }
 
-std::vector<std::vector<std::string>> readCsv(const fs::path& p) {
-    std::ifstream in(p);
-    std::vector<std::vector<std::string>> rows;
-    for (std::string line; std::getline(in, line);) {
-        std::vector<std::string> cells;
-        std::stringstream ss(line);
-        for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
-        rows.push_back(cells);
-    }
-    return rows;
-}
+std::vector<std::vector<std::string>> readCsv(const fs::path& p) { return testing::csvRows(p); }
 
 /// initial + inserted - removed = present, at every row of series.csv.
 void expectBalanced(const fs::path& series, const std::string& method) {

@@ -72,7 +72,8 @@ protected:
     /// Every output a resumed run must reproduce: series.csv, the collections and every snapshot file, by name.
     static std::vector<std::pair<std::string, std::string>> outputs(const fs::path& dir) {
         std::vector<std::pair<std::string, std::string>> files;
-        static const std::regex re(R"(series\.csv|final\.(csv|data)|.*\.pvd|.*_[0-9]{6}\.(vtu|vtp|vti))");
+        static const std::regex re(R"(series\.csv|final\.(csv|data)|.*\.pvd|.*_[0-9]{6}\.(vtu|vtp|vti)|)"
+                                   R"(fields_.*\.csv|contacts_[0-9]{6}\.csv)");
         for (const auto& e : fs::directory_iterator(dir))
             if (std::regex_match(e.path().filename().string(), re))
                 files.emplace_back(e.path().filename().string(), read(e.path()));
@@ -171,6 +172,22 @@ TEST_F(Restart, PolygonsResumeBitForBit) {
 const Scene kGas{
     "dilute_gas3d.toml", {"insert[1].count=300", "output.series_period=0.002", "output.snapshot_period=0.01"}, 0.05};
 const Scene kGas2d{"gas2d.toml", {"method=edm", "output.series_period=0.002", "output.snapshot_period=0.01"}, 0.05};
+
+// The measurements (run/measures.hpp): a [[fields]] window open at a checkpoint, its samples' sums carried in the
+// checkpoint; the contact network and the series' stress; an event-driven gas's collisions in the window.
+const Scene kBed{
+    "bed3d_fields.toml",
+    {"fields[1].period=0.015", "fields[1].window=0.01", "output.series_period=0.002", "output.snapshot_period=0.01"},
+    0.04};
+const Scene kGasFields{
+    "gas3d_fields.toml",
+    {"fields[1].period=0.02", "fields[1].window=0.015", "output.series_period=0.005", "output.snapshot_period=0.01"},
+    0.06};
+
+TEST_F(Restart, FieldsWindowsResumeBitForBit) {
+    expectResumeIdentical(kBed, 2);
+    expectResumeIdentical(kGasFields, 1, false);
+}
 
 TEST_F(Restart, EdmResumesBitForBit) {
     expectResumeIdentical(kGas, 1, false);

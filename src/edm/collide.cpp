@@ -57,7 +57,7 @@ bool EdmEngine<D>::smoothPair(int matA, int matB) const {
 
 template <int D>
 void EdmEngine<D>::notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop,
-                          const Vec<D>& P, std::uint32_t element) {
+                          const Vec<D>& P, const Vec<D>& branch, std::uint32_t element) {
     if (!collisionHook_) return;
     EdmCollision<D> c;
     c.time = t;
@@ -69,6 +69,8 @@ void EdmEngine<D>::notify(double t, std::uint32_t a, std::uint32_t partner, bool
     c.elastic = elastic;
     c.restHop = hop;
     c.impulse = P;
+    c.position = sl_.posAt(sl_.hot[a], t);
+    c.branch = branch;
     collisionHook_(c);
 }
 
@@ -134,7 +136,7 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     ++stats_.pairCollisions;
     if (elastic) ++stats_.tcElastic;
     if (hop) ++stats_.restHops;
-    notify(t, a, b, false, elastic, hop, P);
+    notify(t, a, b, false, elastic, hop, P, d);
 }
 
 // A particle's collision with an infinitely heavy partner at rest or in motion (b2: a plane, a mesh element), once
@@ -184,7 +186,7 @@ void EdmEngine<D>::collideWall(std::uint32_t s, std::uint32_t w, double t) {
         return;
     }
     const WallHit h = wallImpulse(s, t, b1, b2, n, gn, uRest, ma, wl.material, smooth);
-    notify(t, s, w, true, h.elastic, h.hop, h.P);
+    notify(t, s, w, true, h.elastic, h.hop, h.P, n * sl_.hot[s].r);
 }
 
 // A mesh element as a plane wall at rest whose normal is the contact's (predict_mesh.hpp: from the contact point to the
@@ -216,7 +218,7 @@ void EdmEngine<D>::collideMesh(std::uint32_t s, std::uint32_t e, double t) {
         return;
     }
     const WallHit h = wallImpulse(s, t, b1, b2, n, gn, uRest, ma, wallMaterial, smooth);
-    notify(t, s, mesh_.wall(e), true, h.elastic, h.hop, h.P, mesh_.local(e));
+    notify(t, s, mesh_.wall(e), true, h.elastic, h.hop, h.P, n * sl_.hot[s].r, mesh_.local(e));
 }
 
 // The members defined here, for both dimensions (the class itself is instantiated in edm/engine.cpp).
@@ -224,7 +226,7 @@ void EdmEngine<D>::collideMesh(std::uint32_t s, std::uint32_t e, double t) {
     template CollisionLaw EdmEngine<D>::lawFor(int, int, bool, bool) const;                                          \
     template bool EdmEngine<D>::smoothPair(int, int) const;                                                          \
     template void EdmEngine<D>::notify(double, std::uint32_t, std::uint32_t, bool, bool, bool, const Vec<D>&,        \
-                                       std::uint32_t);                                                               \
+                                       const Vec<D>&, std::uint32_t);                                                \
     template void EdmEngine<D>::collidePair(std::uint32_t, std::uint32_t, double);                                   \
     template void EdmEngine<D>::collideWall(std::uint32_t, std::uint32_t, double);                                   \
     template EdmEngine<D>::WallHit EdmEngine<D>::wallImpulse(                                                        \

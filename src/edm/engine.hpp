@@ -92,6 +92,9 @@ struct EdmCollision {
     bool elastic = false;  ///< made elastic by the TC model
     bool restHop = false;  ///< normal speed raised to the rest-hop speed (wall or frozen partner)
     Vec<D> impulse;        ///< impulse on particle i [N s]
+    Vec<D> position;       ///< centre of particle i at the collision [m]
+    /// x_i - x_j (minimum image) for a pair; for a wall, from the contact point to the centre of i [m]
+    Vec<D> branch;
     /// The wall is a mesh: partner is its index in World::surfaces (else in World::walls), element which of its
     /// elements.
     bool surface = false;
@@ -272,7 +275,7 @@ private:
     /// per particle of a collision).
     int materialOf(std::uint32_t i) const { return w_.contact.nMaterials == 1 ? 0 : w_.particles.material[i]; }
     void notify(double t, std::uint32_t a, std::uint32_t partner, bool wall, bool elastic, bool hop, const Vec<D>& P,
-                std::uint32_t element = kNil);
+                const Vec<D>& branch, std::uint32_t element = kNil);
 
     World<D>& w_;
     EdmSettings s_;

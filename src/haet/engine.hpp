@@ -86,6 +86,10 @@ public:
 
     const TdmEngine<D>& tdm() const { return *tdm_; }
     const EdmEngine<D>& edm() const { return *edm_; }
+    /// The measurements' hooks (run/measures.hpp): the time-driven contacts of the step ending at t
+    /// (TdmEngine::recordContactsAt), every event-driven collision (EdmEngine::setObserver).
+    void recordContactsAt(ContactSink<D>* sink, double t) { tdm_->recordContactsAt(sink, t); }
+    void setCollisionHook(std::function<void(const EdmCollision<D>&)> f) { edm_->setObserver(std::move(f)); }
     const ZoneGrid<D>& zones() const { return zones_; }
     const HaetSettings& settings() const { return hs_; }
     double dtMin() const { return edm_->tcTime(); }

@@ -245,6 +245,31 @@ void writeVtpShapes(const std::filesystem::path& path, const WallShapes& sh) {
     arrays.write(path, head);
 }
 
+void writeVtpLines(const std::filesystem::path& path, std::span<const double> xyz,
+                   const std::vector<VtkField>& cellData, double time) {
+    const std::size_t np = xyz.size() / 3, nl = np / 2;
+    std::vector<std::int64_t> index(np), end(nl);
+    for (std::size_t k = 0; k < np; ++k) index[k] = static_cast<std::int64_t>(k);
+    for (std::size_t k = 0; k < nl; ++k) end[k] = static_cast<std::int64_t>(2 * k + 2);
+    AppendedArrays arrays;
+    std::string head = fileHead("PolyData");
+    head += "  <PolyData>\n";
+    head += timeValue(arrays, arrays.keep(std::vector<double>{time}));
+    head += fmt::format(
+        "    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"0\" NumberOfLines=\"{}\" NumberOfStrips=\"0\" "
+        "NumberOfPolys=\"0\">\n",
+        np, nl);
+    head += "      <CellData>\n" + arrays.fields(cellData, nl, 8) + "      </CellData>\n";
+    head += "      <Points>\n" + arrays.tag("Points", VtkField::Float64, 3, np, xyz.data(), 8) + "      </Points>\n";
+    head += "      <Lines>\n";
+    head += arrays.tag("connectivity", VtkField::Int64, 1, np, arrays.keep(std::move(index)), 8);
+    head += arrays.tag("offsets", VtkField::Int64, 1, nl, arrays.keep(std::move(end)), 8);
+    head += "      </Lines>\n";
+    head += "    </Piece>\n";
+    head += "  </PolyData>\n";
+    arrays.write(path, head);
+}
+
 void writeVtiCells(const std::filesystem::path& path, std::array<int, 3> dims, std::array<double, 3> origin,
                    std::array<double, 3> spacing, const std::vector<VtkField>& cellData, double time) {
     std::size_t n = 1;

@@ -42,6 +42,11 @@ void writeVtuPolygons(const std::filesystem::path& path, std::span<const double>
 void writeVtiCells(const std::filesystem::path& path, std::array<int, 3> dims, std::array<double, 3> origin,
                    std::array<double, 3> spacing, const std::vector<VtkField>& cellData, double time);
 
+/// Writes line segments as PolyData (.vtp): xyz holds 6 coordinates per segment (its two ends) [m]; each cellData
+/// field one tuple per segment (the contact network: a line per contact).
+void writeVtpLines(const std::filesystem::path& path, std::span<const double> xyz,
+                   const std::vector<VtkField>& cellData, double time);
+
 /// One planar wall as a quadrilateral (2D walls are passed as thin quads by the caller).
 struct WallQuad {
     std::array<std::array<double, 3>, 4> corners{};  ///< [m], in order around the quad

@@ -2,6 +2,7 @@
 // The engines as the run loop sees them: one Driver per method (time-driven, event-driven, hybrid) gives the loop
 // the same calls (advance, synchronise, the series' columns, checkpoints) and lets the inlets and outlets add and
 // remove particles (FlowHost). Used by run/session.cpp only.
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -78,6 +79,11 @@ public:
     /// Before a checkpoint: the World as it must be saved, without changing what the engine computes next (an
     /// event-driven engine holding the positions gives them back as they are, unsynchronised).
     virtual void exposeState() {}
+    /// The measurements' hooks (run/measures.hpp): the contacts of the force pass at time t into *sink, the time of
+    /// the last pass that recorded them (-1: none), every event-driven collision.
+    virtual void recordContactsAt(ContactSink<D>*, double) {}
+    virtual double contactsRecordedAt() const { return -1; }
+    virtual void setCollisionHook(std::function<void(const EdmCollision<D>&)>) {}
 };
 
 /// The driver's loadState for one engine: the World's particles again (making the engine may have sorted them or
@@ -127,6 +133,8 @@ public:
     bool restartable() const override { return true; }
     void saveState(ByteWriter& out) const override { eng_.saveState(out); }
     void loadState(const CheckpointFile& f) override { loadEngineState(f, w_, eng_); }
+    void recordContactsAt(ContactSink<D>* s, double t) override { eng_.recordContactsAt(s, t); }
+    double contactsRecordedAt() const override { return eng_.contactsRecordedAt(); }
 
 private:
     World<D>& w_;
@@ -175,6 +183,7 @@ public:
     void exposeState() override { eng_.exposeHeldState(); }
     void saveState(ByteWriter& out) const override { eng_.saveState(out); }
     void loadState(const CheckpointFile& f) override { loadEngineState(f, w_, eng_); }
+    void setCollisionHook(std::function<void(const EdmCollision<D>&)> f) override { eng_.setObserver(std::move(f)); }
 
 private:
     World<D>& w_;
@@ -242,6 +251,11 @@ public:
     std::size_t eager() const override { return eng_.nTdm(); }
     void remove(const std::vector<std::uint32_t>& which) override { eng_.removeParticles(which); }
     void added(std::size_t first) override { eng_.addParticles(first); }
+    void recordContactsAt(ContactSink<D>* s, double t) override { eng_.recordContactsAt(s, t); }
+    double contactsRecordedAt() const override { return eng_.tdm().contactsRecordedAt(); }
+    void setCollisionHook(std::function<void(const EdmCollision<D>&)> f) override {
+        eng_.setCollisionHook(std::move(f));
+    }
     bool restartable() const override { return eng_.restartable(); }
     void saveState(ByteWriter& out) const override { eng_.saveState(out); }
     /// The engine loads the World itself, before and after it makes its engines anew (HaetEngine::loadState).

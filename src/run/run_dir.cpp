@@ -12,7 +12,9 @@ bool isRunOutputName(const std::string& name) {
     // The outputs of runner.cpp, and the temporary files of their atomic writes (io/atomic_file.hpp).
     static const std::regex re(
         R"((run\.json|series\.csv|final\.png|final\.csv|final\.data|(particles|walls|zones|polygons)\.pvd|)"
-        R"((particles|polygons)_[0-9]{6,}\.vtu|walls_[0-9]{6,}\.vtp|zones_[0-9]{6,}\.vti|checkpoint_[0-9]{6,}\.haet))"
+        R"((particles|polygons)_[0-9]{6,}\.vtu|walls_[0-9]{6,}\.vtp|zones_[0-9]{6,}\.vti|checkpoint_[0-9]{6,}\.haet|)"
+        // run/measures.hpp: the fields of [[fields]] blocks (names: letters, digits, '_', '-'), the contact network
+        R"(contacts\.pvd|contacts_[0-9]{6,}\.(vtp|csv)|fields_[A-Za-z0-9_-]+(\.pvd|\.csv|_[0-9]{6,}\.vti)))"
         R"((\.tmp\.[0-9]+)?)");
     return std::regex_match(name, re);
 }

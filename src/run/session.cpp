@@ -20,6 +20,7 @@
 #include "run/drivers.hpp"
 #include "run/export.hpp"
 #include "run/flow.hpp"
+#include "run/measures.hpp"
 #include "run/progress.hpp"
 #include "run/run_dir.hpp"
 #include "run/schedule.hpp"
@@ -79,6 +80,10 @@ public:
             flow_->loadState(in);
         }
         for (auto& c : flow_->columns()) columns.push_back(c);
+        // Fields, stress tensors, the contact network (run/measures.hpp), fed by the engine's hooks.
+        measures_.emplace(sc_, world, dir_, plan_.snapshotPeriod);
+        for (auto& c : measures_->columns()) columns.push_back(c);
+        eng_->setCollisionHook([this](const EdmCollision<D>& c) { measures_->collision(c); });
         lastRowTime_ = world.time;
         // A resumed run's series.csv as the stopped run left it, read before it is rewritten.
         std::string savedSeries = resume_ ? readFileText(dir_ / "series.csv") : std::string();
@@ -111,6 +116,9 @@ public:
             const SeriesMark mark = loadSeriesMark(in);
             snaps_->loadState(in);
             in.expectEnd();
+            ByteReader meas = resume_->file.section("MEAS");
+            measures_->loadState(meas);
+            meas.expectEnd();
             series_->resume(seriesAtCheckpoint(std::move(savedSeries), mark, series_->path(), resume_->path),
                             mark.rows);
             if (lastRow_ >= 0) rows_.pass(lastRow_, eps_);
@@ -138,13 +146,22 @@ public:
                     shot(OutputClock::stamp(world.time, shots_.next()));
                     shots_.pass(world.time, eps_);
                 }
+                if (measures_->nextTime() <= world.time + eps_) {
+                    eng_->synchronise();
+                    measures_->sample(world, contactsNow(), eps_);
+                }
                 if (ckpts_.due(world.time, eps_)) {
                     if (lastCheckpoint_ != world.time) checkpoint();
                     ckpts_.pass(world.time, eps_);
                 }
                 if (world.time + eps_ >= until || signals_.requested()) break;
                 // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
-                const double target = std::min({until, rows_.next(), shots_.next(), ckpts_.next(), flow_->nextTime()});
+                const double target = std::min(
+                    {until, rows_.next(), shots_.next(), ckpts_.next(), flow_->nextTime(), measures_->nextTime()});
+                // The force pass at the next time the measurements read them records its contacts.
+                if (measures_->wantsContacts())
+                    eng_->recordContactsAt(measures_->sink(),
+                                           measures_->contactsWantedAt(rows_.next(), shots_.next(), until));
                 while (chunks_.due(world.time, eps_)) chunks_.pass(world.time, eps_);
                 eng_->advanceTo(chunks_.next() < target - eps_ ? chunks_.next() : target);
                 if (world.time + eps_ >= flow_->nextTime()) flow_->act(world, *eng_, eps_);
@@ -248,8 +265,12 @@ private:
                                                   pressure};
         for (auto& v : eng_->extraRow()) row.push_back(v);
         for (auto& v : flow_->row(world.time)) row.push_back(v);
+        for (auto& v : measures_->row(world, contactsNow(), window)) row.push_back(v);
         return row;
     }
+
+    /// Whether the force pass at the current time recorded its contacts (the measurements read them).
+    bool contactsNow() const { return measures_->wantsContacts() && eng_->contactsRecordedAt() == world_->time; }
 
     void row(double stamp) {
         eng_->synchronise();
@@ -260,6 +281,7 @@ private:
     void shot(double stamp) {
         eng_->synchronise();
         snaps_->write(*world_, stamp, eng_->hybrid());
+        measures_->snapshot(*world_, stamp, contactsNow());
         series_->flush();
         lastShot_ = world_->time;
     }
@@ -284,6 +306,9 @@ private:
         body.endSection();
         body.beginSection("FLOW");
         flow_->saveState(body);
+        body.endSection();
+        body.beginSection("MEAS");
+        measures_->saveState(body);
         body.endSection();
         body.beginSection("RUN ");
         body.put<std::uint64_t>(sequence_ + 1);
@@ -381,6 +406,7 @@ private:
     std::optional<Flow<D>> flow_;
     std::optional<SeriesWriter> series_;
     std::optional<SnapshotWriter<D>> snaps_;
+    std::optional<Measures<D>> measures_;
     std::optional<Progress> progress_;
     double eps_ = 0;
     OutputClock rows_{0}, shots_{0}, ckpts_{0}, chunks_{0};

@@ -11,6 +11,7 @@
 
 #include "contact/model.hpp"
 #include "core/vec.hpp"
+#include "measure/cg_kernel.hpp"
 #include "scenario/distribution.hpp"
 
 namespace haet {
@@ -223,6 +224,38 @@ inline constexpr std::array<const char*, 7> kPictureFields = {
     "velocity", "angular_velocity", "force", "radius", "material", "id", "mode"};
 inline constexpr std::array<const char*, 3> kPictureVectorFields = {"velocity", "angular_velocity", "force"};
 
+// ---- Measurements (docs/scenario.md, "Fields", "Regions"; docs/physics.md L) ------------------------------------
+
+/// The fields a [[fields]] block may write (`fields = [...]`), in this order.
+inline constexpr std::array<const char*, 9> kCgFieldNames = {
+    "density",        "volume_fraction",    "velocity", "kinetic_stress", "temperature",
+    "contact_stress", "collisional_stress", "stress",   "mode_fraction"};
+
+/// A [[fields]] block: coarse-grained fields on a grid of 1 to 3 axes over a box, averaged over a time window.
+struct FieldsDef {
+    std::string name;                   ///< names its files: fields_NAME.pvd, fields_NAME_K.vti, fields_NAME.csv
+    int nAxes = 1;                      ///< grid axes
+    std::array<int, 3> axes{2, 0, 1};   ///< box axis of each grid axis (0 x, 1 y, 2 z)
+    std::array<int, 3> cells{1, 1, 1};  ///< cells along each grid axis
+    Vec3d lo{0, 0, 0}, hi{0, 0, 0};     ///< region [m] (default: the domain)
+    CgKernelKind kernel = CgKernelKind::Gaussian;
+    double width = 0;           ///< [m]: the Gaussian's standard deviation, Lucy's support radius
+    double cutoff = 3;          ///< Gaussian cut-off [widths]
+    double window = 0;          ///< [s]: samples in [t - window, t] averaged at each output time t; 0: one sample
+    double sampleInterval = 0;  ///< [s] between samples in a window; 0: window / 10
+    double period = 0;          ///< [s] between outputs; 0: the snapshot period
+    int branchNodes = 3;        ///< Gauss-Legendre nodes along a branch (grids of 2 or 3 axes)
+    std::uint32_t fields = 0;   ///< bit k: kCgFieldNames[k] written
+    SourcePos pos;
+};
+
+/// A [[regions]] block: a named box whose stress tensor goes to series.csv (NAME_stress_xx, ...).
+struct RegionDef {
+    std::string name;
+    Vec3d lo{0, 0, 0}, hi{0, 0, 0};  ///< [m]
+    SourcePos pos;
+};
+
 struct OutputDef {
     std::string directory = "out";  ///< run directory (--out overrides)
     double seriesPeriod = 0;        ///< [s] between rows of series.csv; 0 = 1/100 of duration
@@ -234,6 +267,8 @@ struct OutputDef {
     Vec3d view{0, 1, 0};
     int pictureWidth = 900;
     double checkpointPeriod = 0;  ///< [s] between checkpoints; 0 = none but the one at the end (and at a stop)
+    bool contacts = false;        ///< the contact network at every snapshot (contacts.pvd, contacts_K.csv)
+    bool stress = true;           ///< the stress tensor of the domain and the regions in series.csv
     SourcePos pos;
 };
 
@@ -258,6 +293,8 @@ struct Scenario {
     std::vector<InsertDef> inserts;
     std::vector<OutletDef> outlets;
     std::vector<InletDef> inlets;
+    std::vector<FieldsDef> fields;
+    std::vector<RegionDef> regions;
     OutputDef output;
     std::string hash;  ///< hash of the file contents (hex)
     /// Every key a resume may not change (docs/scenario.md, "Resuming"), one "key = value" line each, after the

@@ -17,6 +17,7 @@
 
 #include "io/spheres.hpp"
 #include "scenario/checks.hpp"
+#include "scenario/fields_loader.hpp"
 #include "scenario/flow_loader.hpp"
 #include "scenario/table_reader.hpp"
 #include "scenario/text.hpp"
@@ -32,7 +33,7 @@ public:
 
     Scenario load() {
         root_.allowOnly({"name", "dimension", "method", "duration", "seed", "domain", "materials", "contact", "tdm",
-                         "edm", "haet", "walls", "insert", "outlet", "inlet", "output"});
+                         "edm", "haet", "walls", "insert", "outlet", "inlet", "output", "fields", "regions"});
         Scenario s;
         s.path = file_;
         readTop(s);
@@ -48,6 +49,7 @@ public:
         readFlows(s);
         checkDiskLaw(s);
         readOutput(s);
+        readMeasures(s);
         checkScenario(s);  // the checks across tables (scenario/checks.hpp)
         return s;
     }
@@ -503,10 +505,26 @@ private:
                        std::string("the region is narrower than one particle diameter on axis ") + kAxisName[k]);
     }
 
+    /// [[fields]] and [[regions]] (scenario/fields_loader.hpp).
+    void readMeasures(Scenario& s) const {
+        if (const toml::array* a = root_.arrayOfTables("fields"))
+            for (std::size_t i = 0; i < a->size(); ++i)
+                s.fields.push_back(loader::readFields(
+                    TableReader(*a->get(i)->as_table(), "fields[" + std::to_string(i + 1) + "]", file_), dim_, s));
+        if (const toml::array* a = root_.arrayOfTables("regions"))
+            for (std::size_t i = 0; i < a->size(); ++i)
+                s.regions.push_back(loader::readRegion(
+                    TableReader(*a->get(i)->as_table(), "regions[" + std::to_string(i + 1) + "]", file_), dim_,
+                    s.domain));
+        loader::checkMeasureNames(s);
+    }
+
     void readOutput(Scenario& s) {
         const TableReader r = child("output");
         r.allowOnly({"directory", "series_period", "snapshot_period", "checkpoint_period", "color_by", "color_range",
-                     "view", "picture_width"});
+                     "view", "picture_width", "contacts", "stress"});
+        s.output.contacts = r.boolean("contacts").value_or(false);
+        s.output.stress = r.boolean("stress").value_or(true);
         OutputDef& o = s.output;
         o.pos = r.tablePos();
         o.directory = r.string("directory").value_or(o.directory);

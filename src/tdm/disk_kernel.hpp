@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 #include "contact/laws.hpp"
 #include "contact/setup.hpp"
@@ -17,11 +18,22 @@
 #include "core/particles.hpp"
 #include "core/wide3.hpp"
 #include "neighbor/pair_list.hpp"
+#include "tdm/contact_record.hpp"
 #include "tdm/pair_block.hpp"
 #include "tdm/pair_pass.hpp"
 #include "tdm/wall_kernel.hpp"
 
 namespace haet {
+
+/// No record of the law's parts: the ordinary passes.
+struct NoLawParts {};
+/// The law's parts of one contact as it computed them (the contact network, tdm/contact_record.hpp).
+template <int D>
+struct LawParts {
+    KernelVec<D> normal, fn, ft;  ///< unit normal (from j to i), normal and tangential force on i [N]
+    KernelVec<D> d;               ///< x_i - x_j with the pair's periodic shift [m]
+    double delta = 0;             ///< overlap [m]
+};
 
 /// What one touching pair adds to its owner (its partner gets -f and n x F_t): f = F on i in a (the virial r . F in
 /// a[3]); n x F_t in b (the overlap / smaller radius in b[3]).
@@ -130,10 +142,12 @@ template <class S, class V, class A>
 /// masses and velocities: F on i, n x F_t and the spring xi (updated), r . F and overlap / smaller radius.
 /// Written once for one pair (S = double) and for four in lanes (S = Lanes; core/lanes.hpp): the same operations
 /// in the same order, so a pair gets the same bits either way.
-template <class Normal, class Tangential, class C, class S, class V, class A>
+/// With parts (one pair, the contact network's pass only) also the law's normal and tangential forces as it
+/// computed them.
+template <class Normal, class Tangential, class C, class S, class V, class A, class Parts = NoLawParts>
 [[gnu::always_inline]] inline void contactLaw(const C& c, const V& d, S dist2, S ri, S rj, S invMi, S invMj,
                                               const RelMotion<V, A>& m, V& xi, bool clip, double dt, V& f, A& nxft,
-                                              S& virial, S& overlap) {
+                                              S& virial, S& overlap, Parts* parts = nullptr) {
     const S rsum = ri + rj;
     const S dist = sqrtOf(dist2);
     const V nrm = d * (1.0 / dist);
@@ -146,6 +160,12 @@ template <class Normal, class Tangential, class C, class S, class V, class A>
     NormalResultOf<S> nr = Normal::eval(c, delta, -gn, meff, reff);
     if (clip) nr.fn = select(nr.fn < 0, S(0.0), nr.fn);
     f = nrm * nr.fn;
+    if constexpr (!std::is_same_v<Parts, NoLawParts>) {
+        parts->normal = nrm;
+        parts->fn = f;
+        parts->ft = V::zero();
+        parts->delta = delta;
+    }
     if constexpr (Tangential::kHasHistory) {
         // w x n lies in the contact plane already: only dv needs its normal part (gn) removed.
         const V gt = dv - nrm * gn - cross(m.wr, nrm);
@@ -153,6 +173,7 @@ template <class Normal, class Tangential, class C, class S, class V, class A>
         const V ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, d, dist2, gt, gs, xi, dt);
         f += ft;
         nxft = cross(nrm, ft);
+        if constexpr (!std::is_same_v<Parts, NoLawParts>) parts->ft = ft;
     } else {
         nxft = A::zero();
     }
@@ -161,9 +182,10 @@ template <class Normal, class Tangential, class C, class S, class V, class A>
 }
 
 /// Evaluates pair slot k of owner a. Returns false when the pair is not touching (its spring is cleared).
-template <int D, class Normal, class Tangential>
+template <int D, class Normal, class Tangential, class Parts = NoLawParts>
 [[gnu::always_inline]] inline bool evalPair(const PairInputs<D>& in, const Owner<D>& a, std::uint32_t k,
-                                            PairForce<D>& out, double& overlapRatio, double& virial) {
+                                            PairForce<D>& out, double& overlapRatio, double& virial,
+                                            Parts* parts = nullptr) {
     using V = KernelVec<D>;
     const std::uint32_t j = in.partner[k];
     V d = a.x - kernelVec(in.x[j]);
@@ -183,7 +205,8 @@ template <int D, class Normal, class Tangential>
     contactLaw<Normal, Tangential>(a.coeffRow[in.material[j]], d, dist2, ri, rj, a.invMass, in.invMass[j],
                                    relMotion(a.v, kernelVec(in.v[j]), a.w, kernelVec(in.w[j]), a.sv,
                                              kernelVec(in.sv[j]), a.sw, kernelVec(in.sw[j]), ri, rj),
-                                   xi, in.clip, in.dt, out.f, out.nxft, vir, overlap);
+                                   xi, in.clip, in.dt, out.f, out.nxft, vir, overlap, parts);
+    if constexpr (!std::is_same_v<Parts, NoLawParts>) parts->d = d;
     if constexpr (Tangential::kHasHistory) in.history[k] = storedVec(xi);
     virial += vir;
     overlapRatio = std::max(overlapRatio, overlap);
@@ -519,6 +542,29 @@ public:
         e.a.c[3] = vir;
         storeRow<A>(e.b.c, pf.nxft);
         e.b.c[3] = overlap;
+        return true;
+    }
+
+    /// One listed pair as pair() evaluates it (the same bits), with the law's parts into rec (the contact network).
+    bool record(std::size_t i, std::uint32_t k, std::uint32_t j, Entry& e, ContactRecord<D>& rec) const {
+        PairForce<D> pf;
+        LawParts<D> parts;
+        double overlap = 0, vir = 0;
+        if (!evalPair<D, Normal, Tangential>(in_, Owner<D>(in_, i), k, pf, overlap, vir, &parts)) return false;
+        storeRow<D>(e.a.c, pf.f);
+        e.a.c[3] = vir;
+        storeRow<A>(e.b.c, pf.nxft);
+        e.b.c[3] = overlap;
+        rec.i = static_cast<std::uint32_t>(i);
+        rec.j = j;
+        rec.wall = -1;
+        rec.normal = storedVec(parts.normal);
+        rec.fn = storedVec(parts.fn);
+        rec.ft = storedVec(parts.ft);
+        rec.branch = storedVec(parts.d);
+        rec.overlap = parts.delta;
+        rec.position = in_.x[i];
+        rec.point = in_.x[i] - rec.normal * (in_.radius[i] - 0.5 * parts.delta);
         return true;
     }
 

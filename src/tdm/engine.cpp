@@ -42,6 +42,7 @@ ForceContext<D> TdmEngine<D>::context(const Vec<D>* sv, const Ang<D>* sw) const 
                      const_cast<std::vector<Vec<D>>&>(wallHistory_), w_.contact, w_.domain, w_.time, s_.dt, sv, sw);
     if (!planeForce_.empty()) ctx.planeForce = const_cast<Vec<D>*>(planeForce_.data());
     if (!surf_.empty()) ctx.surfaces = const_cast<SurfaceState<D>*>(&surf_);
+    ctx.contacts = recordNow_;
     return ctx;
 }
 
@@ -297,7 +298,20 @@ void TdmEngine<D>::finishStep(bool moved, std::atomic<bool>* nextMoved) {
         rebuild(s_.sortEvery > 0 && steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery));
         checkSpeeds();  // O(N) beside the O(N) rebuild; a system that blows up rebuilds at every step
     }
+    // The contact network's step (recordContactsAt): one test of a pointer in every other step.
+    if (recordSink_ && std::abs(w_.time - recordTime_) < 0.5 * s_.dt) [[unlikely]]
+        recordNow_ = recordSink_;
     computeForces(true, nextMoved);
+    if (recordNow_) {
+        // Ids now: a hybrid may reorder its particles before the records are read.
+        const Particles<D>& p = w_.particles;
+        for (ContactRecord<D>& r : *recordNow_) {
+            r.idI = p.id[r.i];
+            r.idJ = r.j == ContactRecord<D>::kWall ? 0 : p.id[r.j];
+        }
+        recordedAt_ = w_.time;
+        recordNow_ = nullptr;
+    }
     checkHealth();
 }
 

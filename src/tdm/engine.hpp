@@ -10,6 +10,7 @@
 #include "contact/kinds.hpp"
 #include "io/checkpoint.hpp"
 #include "neighbor/pair_list.hpp"
+#include "tdm/contact_record.hpp"
 #include "tdm/forces.hpp"
 #include "tdm/integrators.hpp"
 #include "tdm/shape_pass.hpp"
@@ -60,6 +61,15 @@ public:
     /// out[i]: contacts of particle i at the current positions, a wall contact counting 2 (resting on a wall
     /// weighs like two neighbours); saturates at 255. For i < tdmCount().
     void contactCounts(std::vector<std::uint8_t>& out) const;
+
+    /// The contact network: the force pass of the step that ends at time t (to within half a step) puts every
+    /// contact it evaluates into *sink (tdm/contact_record.hpp); null: none. Not for scenes with polygons.
+    void recordContactsAt(ContactSink<D>* sink, double t) {
+        recordSink_ = sink;
+        recordTime_ = t;
+    }
+    /// The time of the last force pass that recorded its contacts [s] (-1: none yet).
+    double contactsRecordedAt() const { return recordedAt_; }
 
     /// Elastic energy stored in contacts (pairs and walls) [J].
     double contactEnergy() const;
@@ -125,7 +135,10 @@ private:
     ForceStats stats_;
     std::unique_ptr<ShapePass> shapes_;  ///< 2D scenes with polygons: their force pass
     std::uint64_t steps_ = 0, rebuilds_ = 0, lastSort_ = 0;
-    double t0_ = 0;  ///< world.time at construction [s]
+    double t0_ = 0;                         ///< world.time at construction [s]
+    ContactSink<D>* recordSink_ = nullptr;  ///< recordContactsAt
+    ContactSink<D>* recordNow_ = nullptr;   ///< the sink, during the force pass that records
+    double recordTime_ = 0, recordedAt_ = -1;
 };
 
 }  // namespace haet

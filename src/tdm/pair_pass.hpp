@@ -41,6 +41,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "contact/setup.hpp"
@@ -49,6 +51,7 @@
 #include "core/wide3.hpp"
 #include "geometry/domain.hpp"
 #include "neighbor/pair_list.hpp"
+#include "tdm/contact_record.hpp"
 #include "tdm/force_stats.hpp"
 #include "tdm/pair_block.hpp"
 #include "tdm/surface_state.hpp"
@@ -72,6 +75,9 @@ struct ForceContext {
     const Ang<D>* sw;  ///< [rad/s]
     Vec<D>* planeForce = nullptr;         ///< null, or each plane contact's force on its particle [N]: [i nWalls + w]
     SurfaceState<D>* surfaces = nullptr;  ///< null, or the walls of any shape with the particles' contacts
+    /// null, or where the pass puts every contact it evaluates (the contact network; the pass then runs on one
+    /// thread through the kernel's record(), the same bits as its blocks: recordingPass)
+    ContactSink<D>* contacts = nullptr;
 };
 
 template <int D>
@@ -377,6 +383,97 @@ template <int D, class K, bool kCross, class Then>
         return blockRange<D, K, kCross>(ctx, kernel, r, bl, then);
 }
 
+/// The kernel K as the contact network's pass runs it: every pair through K::record (one pair, the bits of
+/// K's blocks: tests/test_force_lanes.cpp), every wall contact through its wall kernel with a record, each record
+/// appended to the sink in the pass's order. The same sums in the same order as K's own pass.
+template <int D, class K>
+class RecordingKernel {
+public:
+    using Entry = typename K::Entry;
+    using Load = typename K::Load;
+    using Sum = typename K::Sum;
+    static constexpr bool kOneByOne = K::kOneByOne;
+
+    class Walls {
+    public:
+        Walls(const K& k, ContactSink<D>& sink, std::size_t nWalls, bool surfaces)
+            : w_(k.walls()), sink_(sink), nw_(nWalls), surfaces_(surfaces) {}
+        [[gnu::always_inline]] bool add(std::size_t i, std::size_t w, Vec<D>& f, Ang<D>& tq, double& worst) const {
+            ContactRecord<D> rec;
+            const bool touching = w_.add(i, w, f, tq, worst, &rec);
+            if (touching) sink_.push_back(rec);
+            return touching;
+        }
+        std::uint32_t addSurfaces(std::size_t i, Vec<D>& f, Ang<D>& tq, double& worst) const {
+            return w_.addSurfaces(i, f, tq, worst, &sink_);
+        }
+
+    private:
+        const typename std::remove_cvref_t<decltype(std::declval<const K&>().walls())>& w_;
+        ContactSink<D>& sink_;
+        std::size_t nw_;
+        bool surfaces_;
+    };
+
+    RecordingKernel(const ForceContext<D>& ctx, const K& k)
+        : k_(k),
+          sink_(*ctx.contacts),
+          first_(ctx.pl.first.data()),
+          partner_(ctx.pl.partner.data()),
+          walls_(k, *ctx.contacts, ctx.nWalls, ctx.surfaces != nullptr) {}
+
+    [[gnu::always_inline]] static Load load(const Entry& x) { return K::load(x); }
+    [[gnu::always_inline]] static Sum sumOf(const Vec<D>& f, const Ang<D>& a) { return K::sumOf(f, a); }
+    [[gnu::always_inline]] static void addOwner(Sum& s, const Load& l) { K::addOwner(s, l); }
+    [[gnu::always_inline]] static void addPartner(Vec<D>& f, Ang<D>& a, const Load& l) { K::addPartner(f, a, l); }
+    [[gnu::always_inline]] static auto forceOf(const Sum& s) { return K::forceOf(s); }
+    [[gnu::always_inline]] auto torqueOf(std::size_t i, const Sum& s) const { return k_.torqueOf(i, s); }
+    const Walls& walls() const { return walls_; }
+
+    bool pair(std::size_t i, std::uint32_t k, std::uint32_t j, Entry& e) const {
+        ContactRecord<D> rec;
+        if (!k_.record(i, k, j, e, rec)) return false;
+        sink_.push_back(rec);
+        return true;
+    }
+
+    /// The block's pairs one by one in pair order (no cross pairs: the pass runs on one thread).
+    template <bool kCrossBlock>
+    std::uint32_t block(std::size_t b0, std::size_t b1, std::size_t e, const CrossSlot<Entry>* cross, std::size_t& c,
+                        PairBlock<D, Entry>& bl) const {
+        return walkBlock<kCrossBlock>(
+            first_, partner_, b0, b1, e, cross, c, bl, [](std::size_t) {},
+            [&](std::size_t i, std::uint32_t k, std::uint32_t j, std::uint32_t ne) {
+                if (!pair(i, k, j, bl.out[ne])) return false;
+                bl.owner[ne] = static_cast<std::uint32_t>(i);
+                bl.partner[ne] = j;
+                return true;
+            });
+    }
+
+private:
+    const K& k_;
+    ContactSink<D>& sink_;
+    const std::uint32_t* first_;
+    const std::uint32_t* partner_;
+    Walls walls_;
+};
+
+/// The pass with every contact recorded (ForceContext::contacts): on one thread, through RecordingKernel, which
+/// gives the sums of the ordinary pass in the same order, so the same bits.
+template <int D, class K, class Then>
+[[gnu::noinline]] ForceStats recordingPass(const ForceContext<D>& ctx, const K& kernel,
+                                           PairPassScratch<D, typename K::Entry>& s, Then& then) {
+    using Entry = typename K::Entry;
+    ForceStats st;
+    if (s.blocks.empty()) s.blocks.resize(1);
+    ctx.contacts->clear();
+    const RecordingKernel<D, K> rk(ctx, kernel);
+    const PassRange<Entry> r{0, ctx.p.tdmCount(), nullptr, 0, nullptr, nullptr, nullptr, &st.virial};
+    addTally(st, pairRange<D, RecordingKernel<D, K>, false>(ctx, rk, r, s.blocks[0], then));
+    return st;
+}
+
 /// Forces and torques of every particle by the kernel, then(i, f, torque) run once particle i's are final (it may
 /// change i's velocities, not its position; nothing reads them after). One thread: one pass over the particles.
 /// T threads: the cross pairs of PairList::split first, then the ranges, each on its thread.
@@ -384,6 +481,10 @@ template <int D, class K, class Then>
 ForceStats runPairPass(const ForceContext<D>& ctx, const K& kernel, PairPassScratch<D, typename K::Entry>& s,
                        Then& then) {
     using Entry = typename K::Entry;
+    // The contact network's pass: one test of a pointer in every other step.
+    if constexpr (requires(ContactRecord<D> & rec, Entry & e) { kernel.record(0, 0u, 0u, e, rec); })
+        if (ctx.contacts) [[unlikely]]
+            return recordingPass(ctx, kernel, s, then);
     const std::size_t n = ctx.p.tdmCount();
     const int nt = n >= kParallelMin ? omp_get_max_threads() : 1;
     ForceStats st;

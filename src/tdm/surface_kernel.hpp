@@ -11,6 +11,7 @@
 #include "contact/laws.hpp"
 #include "contact/setup.hpp"
 #include "core/particles.hpp"
+#include "tdm/contact_record.hpp"
 #include "tdm/pair_pass.hpp"
 #include "tdm/surface_state.hpp"
 #include "tdm/wall_law.hpp"
@@ -50,7 +51,8 @@ public:
 
     /// Adds particle i's contacts with walls of any shape to its force f and torque tq, and their overlap / radius to
     /// worst; returns how many touch.
-    std::uint32_t add(std::size_t i, Vec<D>& f, Ang<D>& tq, double& worst) const {
+    /// With sink (the contact network's pass) also each contact as the law computed it.
+    std::uint32_t add(std::size_t i, Vec<D>& f, Ang<D>& tq, double& worst, ContactSink<D>* sink = nullptr) const {
         SurfaceState<D>& s = *s_;
         const std::uint32_t base = s.slotOf[i];
         if (base == SurfaceState<D>::kNoSlots) return 0;
@@ -133,10 +135,21 @@ public:
         for (int q = 0; q < nh; ++q) {
             SurfaceContact<D>& c = now[q];
             const SurfaceWall<D>& wall = walls[c.wall];
-            c.force =
-                wallContactLaw<D, Normal, Tangential>(table_[material_[i] * nMaterials_ + wall.material], c.overlap,
-                                                      c.normal, s.poses[c.wall].surfaceVelocity(c.point), v_[i], w_[i],
-                                                      sv_[i], sw_[i], ri, mass_[i], clip_, c.spring, dt_, f, tq);
+            ContactRecord<D> rec;
+            c.force = wallContactLaw<D, Normal, Tangential>(
+                table_[material_[i] * nMaterials_ + wall.material], c.overlap, c.normal,
+                s.poses[c.wall].surfaceVelocity(c.point), v_[i], w_[i], sv_[i], sw_[i], ri, mass_[i], clip_, c.spring,
+                dt_, f, tq, sink ? &rec.fn : nullptr, sink ? &rec.ft : nullptr);
+            if (sink) [[unlikely]] {
+                rec.i = static_cast<std::uint32_t>(i);
+                rec.wall = wall.id;
+                rec.normal = c.normal;
+                rec.position = xi;
+                rec.point = c.point;
+                rec.branch = xi - c.point;
+                rec.overlap = c.overlap;
+                sink->push_back(rec);
+            }
             worst = std::max(worst, c.overlap / ri);
             slot[q] = c;
         }

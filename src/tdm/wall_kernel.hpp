@@ -8,6 +8,7 @@
 #include "contact/setup.hpp"
 #include "core/particles.hpp"
 #include "geometry/domain.hpp"
+#include "tdm/contact_record.hpp"
 #include "tdm/pair_pass.hpp"
 #include "tdm/surface_kernel.hpp"
 #include "tdm/wall_law.hpp"
@@ -39,7 +40,9 @@ public:
 
     /// Adds wall w's contact with particle i to its force f and torque tq, and its overlap / radius to worst;
     /// returns whether they touch. Not touching, the contact's spring is cleared.
-    [[gnu::always_inline]] bool add(std::size_t i, std::size_t w, Vec<D>& f, Ang<D>& tq, double& worst) const {
+    /// With rec (the contact network's pass) also the contact as the law computed it.
+    [[gnu::always_inline]] bool add(std::size_t i, std::size_t w, Vec<D>& f, Ang<D>& tq, double& worst,
+                                    ContactRecord<D>* rec = nullptr) const {
         const Wall<D>& wall = walls_[w];
         Vec<D>& hist = history_[i * nw_ + w];
         const double ri = radius_[i];
@@ -49,17 +52,28 @@ public:
             if (planeForce_) planeForce_[i * nw_ + w] = Vec<D>::zero();
             return false;
         }
-        const Vec<D> fw = wallContactLaw<D, Normal, Tangential>(table_[material_[i] * nMaterials_ + wall.material],
-                                                                delta, wall.normal, wall.velocityNow, v_[i], w_[i],
-                                                                sv_[i], sw_[i], ri, mass_[i], clip_, hist, dt_, f, tq);
+        const Vec<D> fw = wallContactLaw<D, Normal, Tangential>(
+            table_[material_[i] * nMaterials_ + wall.material], delta, wall.normal, wall.velocityNow, v_[i], w_[i],
+            sv_[i], sw_[i], ri, mass_[i], clip_, hist, dt_, f, tq, rec ? &rec->fn : nullptr, rec ? &rec->ft : nullptr);
+        if (rec) [[unlikely]] {
+            rec->i = static_cast<std::uint32_t>(i);
+            rec->j = ContactRecord<D>::kWall;
+            rec->wall = wall.id;
+            rec->normal = wall.normal;
+            rec->overlap = delta;
+            rec->branch = wall.normal * (ri - delta);
+            rec->position = x_[i];
+            rec->point = x_[i] - rec->branch;
+        }
         if (planeForce_) planeForce_[i * nw_ + w] = fw;
         worst = std::max(worst, delta / ri);
         return true;
     }
 
     /// Adds particle i's contacts with walls of any shape (tdm/surface_kernel.hpp); returns how many touch.
-    [[gnu::always_inline]] std::uint32_t addSurfaces(std::size_t i, Vec<D>& f, Ang<D>& tq, double& worst) const {
-        return surfaces_.add(i, f, tq, worst);
+    [[gnu::always_inline]] std::uint32_t addSurfaces(std::size_t i, Vec<D>& f, Ang<D>& tq, double& worst,
+                                                     ContactSink<D>* sink = nullptr) const {
+        return surfaces_.add(i, f, tq, worst, sink);
     }
     double surfaceEnergy(std::size_t i) const { return surfaces_.energy(i); }
 

@@ -14,18 +14,26 @@ template <int D, class Normal, class Tangential>
 [[gnu::always_inline]] inline Vec<D> wallContactLaw(const PairCoeffs& c, double delta, const Vec<D>& nrm,
                                                     const Vec<D>& u, const Vec<D>& vi, const Ang<D>& wi,
                                                     const Vec<D>& svi, const Ang<D>& swi, double ri, double meff,
-                                                    bool clip, Vec<D>& hist, double dt, Vec<D>& f, Ang<D>& tq) {
+                                                    bool clip, Vec<D>& hist, double dt, Vec<D>& f, Ang<D>& tq,
+                                                    Vec<D>* fnOut = nullptr, Vec<D>* ftOut = nullptr) {
     const Vec<D> dv = vi - u;
     const double gn = dot(dv, nrm);
     NormalResult nr = Normal::eval(c, delta, -gn, meff, ri);
     if (clip && nr.fn < 0) nr.fn = 0;
     f += nrm * nr.fn;
+    // The contact network's pass only: the normal and tangential force as computed here.
+    if (fnOut) [[unlikely]] {
+        *fnOut = nrm * nr.fn;
+        *ftOut = Vec<D>::zero();
+    }
     if constexpr (Tangential::kHasHistory) {
         const Vec<D> gt = dv - nrm * gn - cross(wi * ri, nrm);
         const Vec<D> gs = svi - u - cross(swi * ri, nrm);
         const Vec<D> ft = Tangential::eval(c, nr.fn, nr.k, meff, nrm, gt, gs, hist, dt);
         f += ft;
         tq += cross(nrm, ft) * (-ri);
+        if (ftOut) [[unlikely]]
+            *ftOut = ft;
         return nrm * nr.fn + ft;
     } else {
         return nrm * nr.fn;

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "../csv_util.hpp"
 #include "../physics_util.hpp"
 #include "run/runner.hpp"
 #include "scenario/loader.hpp"
@@ -46,27 +47,12 @@ Series runSilo(const std::string& method, int seed, double duration) {
     std::ostringstream log;
     EXPECT_EQ(runScenario(sc, o, log), RunStatus::Completed) << log.str();
     Series s;
-    std::ifstream in(o.outDir / "series.csv");
-    std::string line;
-    std::getline(in, line);
-    std::vector<std::string> head;
-    {
-        std::stringstream ss(line);
-        for (std::string c; std::getline(ss, c, ',');) head.push_back(c);
-    }
-    auto col = [&](const std::string& name) {
-        return std::size_t(std::find(head.begin(), head.end(), name) - head.begin());
-    };
-    const std::size_t t = col("time"), n = col("n_particles"), d = col("drain_particles"), m = col("n_tdm");
-    while (std::getline(in, line)) {
-        std::vector<std::string> cells;
-        std::stringstream ss(line);
-        for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
-        s.time.push_back(std::stod(cells.at(t)));
-        s.present.push_back(std::stod(cells.at(n)));
-        s.drained.push_back(std::stod(cells.at(d)));
-        s.tdm.push_back(m < cells.size() && !cells[m].empty() ? std::stod(cells[m]) : s.present.back());
-    }
+    const testing::CsvTable csv = testing::readCsv(o.outDir / "series.csv");
+    const bool hybrid = std::find(csv.header.begin(), csv.header.end(), "n_tdm") != csv.header.end();
+    s.time = csv.column("time");
+    s.present = csv.column("n_particles");
+    s.drained = csv.column("drain_particles");
+    s.tdm = hybrid ? csv.column("n_tdm") : s.present;
     fs::remove_all(o.outDir);
     return s;
 }
