@@ -20,7 +20,7 @@ int layerOf(const std::string& path) {
     if (path == "world/world.hpp") return 3;
     static const std::map<std::string, int> kLayers = {
         {"core", 0},    {"io", 1},   {"geometry", 1}, {"contact", 2}, {"neighbor", 3}, {"tdm", 4},  {"edm", 4},
-        {"polygon", 5}, {"haet", 6}, {"scenario", 7}, {"world", 8},   {"run", 9},      {"app", 10},
+        {"polygon", 5}, {"haet", 6}, {"scenario", 7}, {"world", 8},   {"run", 9},      {"app", 10}, {"python", 10},
     };
     const auto it = kLayers.find(path.substr(0, path.find('/')));
     return it == kLayers.end() ? -1 : it->second;

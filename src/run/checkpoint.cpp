@@ -142,6 +142,36 @@ void checkStateKeys(const std::string& saved, const Scenario& sc) {
     differ("the order of its tables", "", "");  // same lines, another text: cannot happen for the loader's text
 }
 
+namespace {
+
+void checkScenarioOf(const ResumePoint& r, const Scenario& sc) {
+    try {
+        ByteReader keys = r.file.section("SCEN");
+        checkStateKeys(keys.getString(), sc);
+        if (r.file.header.scenarioHash != sc.stateHash)
+            throw CheckpointError(CheckpointFault::OtherScenario, "the checkpoint is of another scenario (hash " +
+                                                                      r.file.header.scenarioHash + ", this one's " +
+                                                                      sc.stateHash + ")");
+    } catch (const CheckpointError& e) {
+        throw CheckpointError(e.fault(), r.path.string() + ": " + e.what());
+    }
+}
+
+}  // namespace
+
+ResumePoint readCheckpoint(const std::filesystem::path& file, const Scenario& sc) {
+    ResumePoint r;
+    r.path = file;
+    try {
+        r.bytes = readWhole(file);
+        r.file = parseCheckpoint(r.bytes);
+    } catch (const CheckpointError& e) {
+        throw CheckpointError(e.fault(), file.string() + ": " + e.what());
+    }
+    checkScenarioOf(r, sc);
+    return r;
+}
+
 ResumePoint findCheckpoint(const std::filesystem::path& dir, const Scenario& sc, std::ostream& log) {
     const std::vector<std::filesystem::path> all = listCheckpoints(dir);
     if (all.empty())
@@ -162,16 +192,7 @@ ResumePoint findCheckpoint(const std::filesystem::path& dir, const Scenario& sc,
             why += "\n  " + p.string() + ": " + e.what();
             continue;
         }
-        try {
-            ByteReader keys = r.file.section("SCEN");
-            checkStateKeys(keys.getString(), sc);
-            if (r.file.header.scenarioHash != sc.stateHash)
-                throw CheckpointError(CheckpointFault::OtherScenario, "the checkpoint is of another scenario (hash " +
-                                                                          r.file.header.scenarioHash + ", this one's " +
-                                                                          sc.stateHash + ")");
-        } catch (const CheckpointError& e) {
-            throw CheckpointError(e.fault(), p.string() + ": " + e.what());
-        }
+        checkScenarioOf(r, sc);
         return r;
     }
     throw CheckpointError(CheckpointFault::Corrupt, dir.string() + ": no whole checkpoint to resume from:" + why);
