@@ -32,13 +32,21 @@ rm -rf "$dir.probe"
 duration=$(python3 -c "print(repr($STEPS * $dt))")
 echo "soak: $(basename "$SCENE"), $STEPS steps of $dt s = $duration s simulated, one thread"
 
+# The periods first: the background command's only child must be the run.
+rows=$(python3 -c "print(repr($duration / 500))")
+shots=$(python3 -c "print(repr($duration / 10))")
 /usr/bin/time -f "%U %S %e" -o "$dir.time" "$haet" run "$SCENE" --set "duration=$duration" \
-    --set "output.series_period=$(python3 -c "print(repr($duration / 500))")" \
-    --set "output.snapshot_period=$(python3 -c "print(repr($duration / 10))")" \
-    --out "$dir/run" --threads 1 --quiet &
+    --set "output.series_period=$rows" --set "output.snapshot_period=$shots" --out "$dir/run" --threads 1 --quiet &
 pid=$!
-sleep 0.2
-child=$(pgrep -P "$pid" -x haet || echo "$pid")
+# /usr/bin/time's child is the run (named "exe" once it has re-executed itself with its OpenMP settings): wait
+# until it has been started.
+child=""
+for _ in $(seq 1 100); do
+    child=$(pgrep -P "$pid" | head -n 1 || true)
+    [ -n "$child" ] && break
+    sleep 0.1
+done
+[ -n "$child" ] || { echo "soak: the run did not start" >&2; exit 1; }
 echo "wall_s,rss_bytes" >"$dir/rss.csv"
 start=$(date +%s.%N)
 while kill -0 "$pid" 2>/dev/null; do

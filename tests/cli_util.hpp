@@ -2,10 +2,12 @@
 // The `haet` command line run as a real process (HAET_BINARY) in a fresh directory per test, and checkers of what a
 // run writes (series.csv, .pvd collections, run.json). Shared by the command line's tests.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cctype>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -65,8 +67,11 @@ protected:
     }
 
     /// Starts `haet ARGS` as a child process, its stdout and stderr to files in the test's directory, with the
-    /// environment changed by `env`; returns its pid for signals and wait().
-    pid_t spawn(const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
+    /// environment changed by `env`; returns its pid for signals and wait(). fileSizeLimit [bytes]: no file the child
+    /// writes may grow beyond it (RLIMIT_FSIZE, with SIGXFSZ ignored: a write past it fails with EFBIG, as on a full
+    /// disk), for the tests of failed writes without a full file system.
+    pid_t spawn(const std::vector<std::string>& args, const std::vector<std::string>& env = {},
+                rlim_t fileSizeLimit = RLIM_INFINITY) {
         const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
         std::vector<std::string> argv = {HAET_BINARY};
         argv.insert(argv.end(), args.begin(), args.end());
@@ -76,6 +81,11 @@ protected:
         if (pid == 0) {
             std::freopen(out.c_str(), "w", stdout);
             std::freopen(err.c_str(), "w", stderr);
+            if (fileSizeLimit != RLIM_INFINITY) {
+                std::signal(SIGXFSZ, SIG_IGN);  // kept across exec
+                const rlimit lim{fileSizeLimit, fileSizeLimit};
+                setrlimit(RLIMIT_FSIZE, &lim);
+            }
             for (const std::string& e : env)  // NAME=VALUE sets, NAME alone unsets
                 if (e.find('=') == std::string::npos)
                     unsetenv(e.c_str());

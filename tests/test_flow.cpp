@@ -144,11 +144,13 @@ TEST(Outlet, CounterCountsEachParticleOnceAndKeepsIt) {
     EXPECT_EQ(*row[6], 1);
     EXPECT_EQ(host.removed, 1u);
     EXPECT_EQ(std::count(p.id.begin(), p.id.end(), id0), 0);
+    EXPECT_EQ(flow.remembered(0), 0u) << "a removed particle is forgotten: the counter's memory stays bounded";
     // Every other particle below the plane now: each counted once.
     for (std::size_t i = 0; i < p.size(); ++i) p.x[i][2] = 0.005;
     w.time += 1e-4;
     flow.act(w, host, 1e-9);
     EXPECT_EQ(*flow.row(w.time)[3], 400);
+    EXPECT_EQ(flow.remembered(0), 399u);
 }
 
 TEST(Inlet, DeliversItsRateInKilogramsPerSecond) {

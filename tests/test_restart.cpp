@@ -3,8 +3,10 @@
 // kind of scene, on one and two threads; a checkpoint that is truncated, corrupt, of a later format or of another
 // scenario is refused with exit code 2 and a message that says which, and a corrupt newest one gives way to the one
 // before it. The runs are of the `haet` program, on scenes of examples/ shortened by overrides.
+#include <algorithm>
 #include <csignal>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,6 +27,28 @@ struct Scene {
     double duration;  ///< T [s]
 };
 
+/// The last value of column `name` of a series.csv.
+double lastValue(const std::string& csv, const std::string& name) {
+    std::istringstream in(csv);
+    std::string header, line, last;
+    std::getline(in, header);
+    while (std::getline(in, line))
+        if (!line.empty()) last = line;
+    auto cells = [](const std::string& row) {
+        std::vector<std::string> out;
+        std::stringstream ss(row);
+        for (std::string c; std::getline(ss, c, ',');) out.push_back(c);
+        return out;
+    };
+    const auto h = cells(header), v = cells(last);
+    const auto at = std::find(h.begin(), h.end(), name);
+    if (at == h.end() || static_cast<std::size_t>(at - h.begin()) >= v.size()) {
+        ADD_FAILURE() << "no column " << name;
+        return 0;
+    }
+    return std::stod(v[static_cast<std::size_t>(at - h.begin())]);
+}
+
 class Restart : public Cli {
 protected:
     /// `haet run -q examples/SCENE` with the scene's overrides and `extra`, into out.
@@ -38,11 +62,17 @@ protected:
         return haet(args);
     }
     static std::string duration(double t) { return "duration=" + std::to_string(t); }
+    /// A hybrid run changed modes both ways (or handed grains over by the modified EDM).
+    static void expectModeChanges(const fs::path& dir) {
+        const std::string csv = read(dir / "series.csv");
+        EXPECT_GT(lastValue(csv, "to_tdm"), 0) << dir;
+        EXPECT_GT(lastValue(csv, "to_edm") + lastValue(csv, "tc_handovers"), 0) << dir;
+    }
 
     /// Every output a resumed run must reproduce: series.csv, the collections and every snapshot file, by name.
     static std::vector<std::pair<std::string, std::string>> outputs(const fs::path& dir) {
         std::vector<std::pair<std::string, std::string>> files;
-        static const std::regex re(R"(series\.csv|.*\.pvd|.*_[0-9]{6}\.(vtu|vtp|vti))");
+        static const std::regex re(R"(series\.csv|final\.(csv|data)|.*\.pvd|.*_[0-9]{6}\.(vtu|vtp|vti))");
         for (const auto& e : fs::directory_iterator(dir))
             if (std::regex_match(e.path().filename().string(), re))
                 files.emplace_back(e.path().filename().string(), read(e.path()));
@@ -118,6 +148,24 @@ TEST_F(Restart, TdmWithInletsOutletsAndSegmentsResumesBitForBit) {
     for (int threads : {1, 2}) expectResumeIdentical(kSilo, threads);
 }
 
+// Polygons (Gear's integrator, the overlap-area law, their tangential springs in the pair list): a box of hexagons and
+// random convex shapes settling on planes, and a hopper of segment walls (their contacts with walls of any shape).
+const Scene kPolygonBox{
+    "box2d_polygons.toml",
+    {"insert[1].count=100", "insert[2].count=100", "output.series_period=0.01", "output.snapshot_period=0.05"},
+    0.2};
+const Scene kPolygonHopper{"hopper2d_polygons.toml",
+                           {"insert[1].count=300", "output.series_period=0.002", "output.snapshot_period=0.01"},
+                           0.04};
+
+TEST_F(Restart, PolygonsResumeBitForBit) {
+    for (int threads : {1, 2}) {
+        expectResumeIdentical(kPolygonBox, threads);
+        EXPECT_GT(lastValue(read(dir_ / "full" / "series.csv"), "n_contacts"), 50);
+        expectResumeIdentical(kPolygonHopper, threads);
+    }
+}
+
 // Event-driven: a gas in a periodic box (cell crossings, collisions, the TC model's clocks, the re-sorting of the
 // slots), and a 2D gas in a closed box (plane walls).
 const Scene kGas{
@@ -127,6 +175,104 @@ const Scene kGas2d{"gas2d.toml", {"method=edm", "output.series_period=0.002", "o
 TEST_F(Restart, EdmResumesBitForBit) {
     expectResumeIdentical(kGas, 1, false);
     expectResumeIdentical(kGas2d, 1, false);
+}
+
+// The hybrid: the demo's bed with its stream just above it (grains land and change mode within the run), and the
+// silo of segments with its inlet and outlets (particles born and removed in either mode). The state of every part
+// is saved (haet/state.cpp); the hybrid steps whole time steps whatever the pieces it is called in, so the run to T/2
+// resumed to T matches too. The runs are checked to change modes, or they would not test the books of a change.
+const Scene kHaetDemo{
+    "haet_demo.toml",
+    {"insert[1].count=250", "insert[2].count=800", "insert[2].region={lo=[0.05,0.016],hi=[0.25,0.05]}",
+     "contact.duration=4e-4", "output.series_period=0.004", "output.snapshot_period=0.02"},
+    0.08};
+const Scene kHaetSilo{"silo2d.toml",
+                      {"insert[1].count=800", "inlet[1].end=1", "outlet[1].interval=1e-3", "outlet[2].interval=1e-3",
+                       "output.series_period=0.002", "output.snapshot_period=0.01"},
+                      0.04};
+
+TEST_F(Restart, HybridResumesBitForBit) {
+    for (int threads : {1, 2}) {
+        expectResumeIdentical(kHaetDemo, threads);
+        expectModeChanges(dir_ / "full");
+    }
+}
+
+TEST_F(Restart, HybridWithInletsOutletsAndSegmentsResumesBitForBit) {
+    for (int threads : {1, 2}) {
+        expectResumeIdentical(kHaetSilo, threads);
+        expectModeChanges(dir_ / "full");
+    }
+}
+
+// An output directory that cannot be made (a file stands in its way) or written in: exit code 4, the path named.
+TEST_F(Restart, UnwritableOutputIsExitFourNamingThePath) {
+    write("afile", "not a directory");
+    for (const fs::path& out : {dir_ / "afile" / "run", fs::path("/proc/self")}) {
+        const Result r = haet("run -q '" + std::string(HAET_SOURCE_DIR) + "/examples/drop3d_tiny.toml' --out '" +
+                              out.string() + "'");
+        EXPECT_EQ(r.code, 4) << r.err;
+        EXPECT_NE(r.err.find("cannot write an output: " + out.string()), std::string::npos) << r.err;
+    }
+}
+
+// A disk that fills up: the run resumed from T/2 may write no file larger than its snapshots (RLIMIT_FSIZE with
+// SIGXFSZ ignored: a write past the limit fails with EFBIG, as one on a full disk with ENOSPC), so its next
+// checkpoint fails. Exit code 4 naming the file; every file left is whole (no temporary file renamed into place,
+// none left behind; the checkpoints before parse, series.csv and the collections are complete, run.json says
+// "failed: output"); resumed on a disk with room, the run writes the bytes of the run that never failed.
+TEST_F(Restart, FullDiskIsExitFourAndLeavesEveryFileWhole) {
+    const Scene& s = kSilo;
+    const std::string period = "output.checkpoint_period=" + std::to_string(s.duration / 4);
+    const fs::path full = dir_ / "full", out = dir_ / "out";
+    Result r = run(s, full, 1, {duration(s.duration), period});
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = run(s, out, 1, {duration(s.duration / 2), period});
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::uintmax_t largest = 0, smallestCheckpoint = ~std::uintmax_t{0};
+    for (const auto& e : fs::directory_iterator(full)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind("checkpoint_", 0) == 0)
+            smallestCheckpoint = std::min(smallestCheckpoint, e.file_size());
+        else if (name.rfind("final", 0) != 0)
+            largest = std::max(largest, e.file_size());
+    }
+    ASSERT_LT(largest, smallestCheckpoint) << "a checkpoint is the largest file the run writes before its end";
+    const auto before = haet::listCheckpoints(out);
+    ASSERT_EQ(before.size(), 2u);
+
+    std::vector<std::string> args = {"run",        "-q",    std::string(HAET_SOURCE_DIR) + "/examples/" + s.file,
+                                     "--threads",  "1",     "--resume",
+                                     out.string(), "--set", duration(s.duration),
+                                     "--set",      period};
+    for (const std::string& v : s.sets) args.insert(args.end(), {"--set", v});
+    // First a limit below the checkpoints only, then one below the snapshots too (written through a stream).
+    const fs::path checkpoint =
+        out / haet::checkpointFileName(haet::parseCheckpoint(read(before[0])).header.sequence + 1);
+    for (const auto& [limit, failing] : {std::pair{(largest + smallestCheckpoint) / 2, checkpoint.string()},
+                                         std::pair{largest / 2, (out / "particles_").string()}}) {
+        SCOPED_TRACE("at most " + std::to_string(limit) + " bytes a file");
+        const int code = wait(spawn(args, {}, limit));
+        const std::string err = read(dir_ / "stderr.txt");
+        EXPECT_EQ(code, 4) << err;
+        EXPECT_NE(err.find("cannot write an output: " + failing), std::string::npos) << err;
+        EXPECT_NE(err.find(".tmp."), std::string::npos) << err;  // the temporary file it wrote
+        EXPECT_NE(err.find("File too large"), std::string::npos) << err;
+
+        for (const auto& e : fs::directory_iterator(out))
+            EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path() << " left behind";
+        EXPECT_EQ(haet::listCheckpoints(out), before);
+        for (const fs::path& k : before) EXPECT_NO_THROW(haet::parseCheckpoint(read(k))) << k;
+        EXPECT_GE(checkSeries(out / "series.csv"), 10);
+        EXPECT_GE(checkPvd(out / "particles.pvd"), 3);
+        const std::string json = read(out / "run.json");
+        EXPECT_TRUE(JsonCheck(json).valid()) << json;
+        EXPECT_EQ(jsonString(json, "status").rfind("failed: output: " + failing, 0), 0u) << json;
+    }
+
+    r = run(s, out, 1, {duration(s.duration), period}, out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    expectSameOutputs(full, out);
 }
 
 /// The files of a run to T with checkpoints, and a copy of its directory to resume from.
@@ -190,6 +336,16 @@ TEST_F(RestartFaults, LaterFormatIsExitTwo) {
     EXPECT_NE(r.err.find("format version " + std::to_string(haet::kCheckpointVersion + 1)), std::string::npos) << r.err;
 }
 
+TEST_F(RestartFaults, EarlierFormatIsExitTwo) {
+    const fs::path c = copy();
+    for (const fs::path& k : kept_) patch(c / k.filename(), 8, char(haet::kCheckpointVersion - 1));
+    const Result r = resume(c);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("format version " + std::to_string(haet::kCheckpointVersion - 1) + ", older than"),
+              std::string::npos)
+        << r.err;
+}
+
 TEST_F(RestartFaults, AnotherScenarioIsExitTwoNamingTheKey) {
     const fs::path c = copy();
     Result r = resume(c, {"materials.glass.restitution=0.5"});
@@ -213,6 +369,61 @@ TEST_F(Restart, DurationDefaultsAreNamed) {
     r = run(s, dir_ / "run", 1, {duration(0.02)}, (dir_ / "run").string());
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find("inlet[1].end changed (checkpoint: 0.01 (the default, from duration"), std::string::npos)
+        << r.err;
+}
+
+// The files a scenario names are part of it by their contents: a particle file or an STL mesh changed since the
+// checkpoint was written is refused on resume, naming the file (the particles come from the checkpoint, but the
+// scenario is another one). The scene: the tiny drop with its spheres read from the file the run of the tiny scene
+// wrote as its final state, and a floor of two triangles from an STL file.
+TEST_F(Restart, ChangedParticleOrMeshFileIsExitTwoNamingIt) {
+    Result r = haet("run -q '" + std::string(HAET_SOURCE_DIR) + "/examples/drop3d_tiny.toml' --out '" +
+                    (dir_ / "first").string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const fs::path bed = dir_ / "bed.csv";
+    fs::copy_file(dir_ / "first" / "final.csv", bed);
+    auto facet = [](const std::string& a, const std::string& b, const std::string& c) {
+        return " facet normal 0 0 1\n  outer loop\n   vertex " + a + "\n   vertex " + b + "\n   vertex " + c +
+               "\n  endloop\n endfacet\n";
+    };
+    const std::string floor = "solid floor\n" + facet("0 0 0.0002", "0.01 0 0.0002", "0.01 0.01 0.0002") +
+                              facet("0 0 0.0002", "0.01 0.01 0.0002", "0 0.01 0.0002") + "endsolid floor\n";
+    const fs::path stl = write("floor.stl", floor);
+    std::string text =
+        withInsert("arrangement = \"file\"\nfile = \"bed.csv\"\nformat = \"csv\"\nmaterial = \"glass\"\n");
+    text.replace(text.find("[[insert]]"), 0,
+                 "[[walls]]\ntype = \"mesh\"\nfile = \"floor.stl\"\nmaterial = \"glass\"\n\n");
+    const fs::path scene = write("staged.toml", text);
+    const fs::path out = dir_ / "run";
+    auto runIt = [&](bool resume) {
+        return haet("run -q '" + scene.string() + "' " + (resume ? "--resume '" : "--out '") + out.string() +
+                    "' --set duration=" + (resume ? "0.002" : "0.001") + " --set output.checkpoint_period=5e-4");
+    };
+    r = runIt(false);
+    ASSERT_EQ(r.code, 0) << r.err;
+    ASSERT_EQ(runIt(true).code, 0) << "unchanged files resume";
+    // A resume that went on wrote checkpoints of its own: start again from the first run's.
+    fs::remove_all(out);
+    ASSERT_EQ(runIt(false).code, 0);
+
+    std::ofstream(bed, std::ios::app) << "# the same particles, another file\n";
+    r = runIt(true);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find(bed.string() + ": the file of insert[1].file has changed since the checkpoint"),
+              std::string::npos)
+        << r.err;
+
+    fs::copy_file(dir_ / "first" / "final.csv", bed, fs::copy_options::overwrite_existing);
+    ASSERT_EQ(runIt(true).code, 0) << "the file as it was resumes";
+    fs::remove_all(out);
+    ASSERT_EQ(runIt(false).code, 0);
+    std::string moved = floor;
+    moved.replace(moved.find("0 0.01 0.0002"), 13, "0 0.01 0.0003");
+    std::ofstream(stl, std::ios::binary) << moved;
+    r = runIt(true);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find(stl.string() + ": the file of walls[2].file has changed since the checkpoint"),
+              std::string::npos)
         << r.err;
 }
 
@@ -315,6 +526,16 @@ TEST_F(RestartSignals, StoppedEventDrivenRunResumesToTheSameBytes) {
                "output.checkpoint_period=0.01"},
               1.5};
     expectStoppedRunsResume(40, 200);
+}
+
+// The hybrid stops after the step under way, its event-driven particles each at its own clock.
+TEST_F(RestartSignals, StoppedHybridRunResumesToTheSameBytes) {
+    scene_ = {"haet_demo.toml",
+              {"insert[1].count=250", "insert[2].count=800", "insert[2].region={lo=[0.05,0.016],hi=[0.25,0.05]}",
+               "contact.duration=4e-4", "output.series_period=0.002", "output.snapshot_period=0.02",
+               "output.checkpoint_period=0.01"},
+              0.16};
+    expectStoppedRunsResume(25, 50);
 }
 
 TEST_F(RestartSignals, KillNineLeavesAWholeCheckpointToResumeFrom) {

@@ -135,7 +135,9 @@ TEST_F(RunStops, OpenMpThreadsWaitPassively) {
                                 {"duration=100", "output.series_period=1e-3", "output.snapshot_period=-1"}, out, {env});
         waitForRows(out, 3);
         const std::string environ = read("/proc/" + std::to_string(pid) + "/environ");
+        const std::string comm = read("/proc/" + std::to_string(pid) + "/comm");  // the name ps and pkill see
         kill(pid, SIGTERM);
+        EXPECT_EQ(comm, "haet\n") << env;
         EXPECT_EQ(wait(pid), 143);
         const std::string expect = env.size() > 15 ? "OMP_WAIT_POLICY=active" : "OMP_WAIT_POLICY=passive";
         EXPECT_NE(environ.find(expect + '\0'), std::string::npos) << env;

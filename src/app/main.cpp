@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -29,7 +30,10 @@ namespace {
 void passiveOpenMpWaiting(char** argv) {
     if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
     if (setenv("OMP_WAIT_POLICY", "passive", 0) != 0) return;
-    execv("/proc/self/exe", argv);  // returns only if it failed: then run on as before
+    // The binary's own path rather than /proc/self/exe, so that the process keeps its name (ps, top, pkill haet).
+    std::array<char, 4096> self{};
+    const ssize_t n = readlink("/proc/self/exe", self.data(), self.size() - 1);
+    execv(n > 0 ? self.data() : "/proc/self/exe", argv);  // returns only if it failed: then run on as before
 }
 
 }  // namespace

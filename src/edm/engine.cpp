@@ -216,6 +216,8 @@ void EdmEngine<D>::buildGrid() {
     // Rec::cell's bits).
     const double maxCells = std::max(1048576.0, 8.0 * static_cast<double>(w_.particles.size()));
     grid_.build(w_.domain, edge, maxCells);
+    gridEdge_ = edge;
+    gridCap_ = maxCells;
 }
 
 // Reorders the slots cell by cell (stable in the current order): neighbours in space become neighbours in memory.

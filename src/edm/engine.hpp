@@ -192,10 +192,11 @@ public:
     const edm::MeshWalls<D>& meshWalls() const { return mesh_; }
 
     // ---- checkpoints (edm/state.cpp; ARCHITECTURE.md, "Checkpoints") ----
-    /// Whether saveState can hold the whole state: not with neighbour shells, whose lists it does not save.
-    bool restartable() const { return !shells_.on() && !s_.reference; }
+    /// Whether saveState can hold the whole state: not in reference mode (tests), which keeps no events.
+    bool restartable() const { return !s_.reference; }
     /// The slots as they are (each particle at its own clock: nothing is advanced), their pending events, the TC
-    /// model's clocks, the free slots and the counters. Between calls of advanceEvents; the grid's cell lists and the
+    /// model's clocks, the free slots, the grid's parameters, the neighbour shells' centres and lists, and the
+    /// counters. Between calls of advanceEvents; the grid's cell lists and the
     /// queue are made again from the slots on loading, which orders nothing differently (pops go by time, then slot;
     /// a scan's best by time, then code, whatever the order of the cells' lists).
     void saveState(ByteWriter& out) const;
@@ -281,6 +282,7 @@ private:
     double maxRate_ = 0;  // events per moving particle per second (0: none)
     std::size_t nMoving_ = 0;
     double rmax_ = 0;
+    double gridEdge_ = 0, gridCap_ = 0;  // what the grid was built from at the last reset (buildGrid) [m], [cells]
 
     Sl sl_;                   // per slot: Hot, Link, Rec
     EventCalendar queue_;     // pending event times

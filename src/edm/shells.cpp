@@ -145,6 +145,43 @@ void Shells<D>::buildLists(const Sl& sl, const EventGrid<D>& grid) {
     }
 }
 
+template <int D>
+void Shells<D>::save(ByteWriter& out) const {
+    out.put<std::uint64_t>(centre_.size());
+    for (const Centre& c : centre_) {  // field by field: the record is padded to 32 bytes
+        out.put(c.c);
+        out.put(c.r);
+    }
+    out.put<std::uint64_t>(rowLen_);
+    out.putVector(nbr_);
+}
+
+template <int D>
+void Shells<D>::load(ByteReader& in, std::size_t n) {
+    if (in.get<std::uint64_t>() != n) in.fail("the neighbour shells are of another number of slots");
+    if (n > in.rest().size() / sizeof(Centre)) in.fail("more shells than the bytes left hold");
+    std::vector<Centre> centres(n);
+    for (Centre& c : centres) {
+        c.c = in.get<Vec<D>>();
+        c.r = in.get<double>();
+    }
+    const auto len = in.get<std::uint64_t>();
+    std::vector<std::uint32_t> rows;
+    if (n > 0 && (len == 0 || len > in.rest().size() / (n * sizeof(std::uint32_t))))
+        in.fail("the neighbour lists' rows do not fit the bytes left");
+    in.getVector(rows, n * len, "the neighbour lists");
+    // Every row's count within its row, every entry a slot: the scans read no further.
+    for (std::size_t s = 0; s < n; ++s) {
+        const std::uint32_t* a = &rows[s * len];
+        if (a[0] >= len) in.fail("a neighbour list longer than its row");
+        for (std::uint32_t q = 1; q <= a[0]; ++q)
+            if ((a[q] & kSlotMask) >= n) in.fail("a neighbour list names a slot out of range");
+    }
+    centre_.swap(centres);
+    rowLen_ = len;
+    nbr_.swap(rows);
+}
+
 template class Shells<2>;
 template class Shells<3>;
 

@@ -17,6 +17,7 @@
 #include "edm/event_grid.hpp"
 #include "edm/scan.hpp"
 #include "edm/slots.hpp"
+#include "io/checkpoint.hpp"
 
 namespace haet::edm {
 
@@ -61,6 +62,11 @@ public:
         const std::uint32_t* a = row(s);
         for (std::uint32_t q = 1; q <= a[0]; ++q) f(a[q] & kSlotMask);
     }
+    /// The centres and the lists as they are (a checkpoint: rebuilt, the lists would hold the same pairs in another
+    /// order, and another row length would change when a list is full).
+    void save(ByteWriter& out) const;
+    /// Takes saved centres and lists for n slots; throws CheckpointError (Corrupt) when they do not fit.
+    void load(ByteReader& in, std::size_t n);
     std::size_t memoryBytes() const {
         return centre_.capacity() * sizeof(Centre) + nbr_.capacity() * sizeof(std::uint32_t);
     }

@@ -1,7 +1,8 @@
 // The event-driven engine's state in a checkpoint (EdmEngine::saveState, loadState; ARCHITECTURE.md, "Checkpoints").
-// The slots are saved as they are, each particle at its own clock with its pending event: synchronising them first
-// would move every clock to one time, and the events then pending, predicted from the earlier states, would not be
-// the ones a prediction from the synchronised states finds (their last bits differ), so the run would not go on as
+// The neighbour shells are saved with their lists as they are, which a rebuild from the centres would order
+// otherwise. The slots are saved as they are, each particle at its own clock with its pending event: synchronising them
+// first would move every clock to one time, and the events then pending, predicted from the earlier states, would not
+// be the ones a prediction from the synchronised states finds (their last bits differ), so the run would not go on as
 // the one that was never stopped.
 #include <cmath>
 
@@ -11,9 +12,12 @@ namespace haet {
 
 template <int D>
 void EdmEngine<D>::saveState(ByteWriter& out) const {
-    if (!restartable()) throw std::logic_error("event-driven engine: no checkpoint with neighbour shells");
-    out.put<std::uint64_t>(grid_.count());
+    if (!restartable()) throw std::logic_error("event-driven engine: no checkpoint in reference mode");
+    // The grid as the last reset made it (from the particles then, which inlets and outlets change since).
+    out.put<double>(gridEdge_);
+    out.put<double>(gridCap_);
     out.put<double>(rmax_);
+    out.put<std::uint64_t>(grid_.count());
     out.putVector(sl_.hot);
     out.putVector(sl_.link);
     out.putVector(sl_.rec);
@@ -22,6 +26,8 @@ void EdmEngine<D>::saveState(ByteWriter& out) const {
     out.putVector(times);
     out.putVector(tc_.lastCollisions());
     out.putVector(free_);
+    out.put<std::uint8_t>(shells_.on());
+    if (shells_.on()) shells_.save(out);
     out.put<std::uint64_t>(nLive_);
     out.put<std::uint64_t>(nMoving_);
     out.put<double>(maxRate_);
@@ -39,10 +45,16 @@ void EdmEngine<D>::saveState(ByteWriter& out) const {
 
 template <int D>
 void EdmEngine<D>::loadState(ByteReader& in) {
-    if (!restartable()) in.fail("an event-driven engine with neighbour shells cannot be resumed");
-    // The grid is made from the scenario and the particles at the last reset, as the saved one was: the same cells.
-    if (in.get<std::uint64_t>() != grid_.count()) in.fail("the event grid has another number of cells");
-    if (in.get<double>() != rmax_) in.fail("the event grid was made for another largest radius");
+    if (!restartable()) in.fail("an event-driven engine in reference mode cannot be resumed");
+    // The grid as the saved one was made, from the parameters of its last reset: the engine made on the loaded
+    // World has counted other particles if inlets or outlets changed them since.
+    const double edge = in.get<double>(), cap = in.get<double>(), rmax = in.get<double>();
+    if (!(edge > 0) || !(cap >= 1) || !(rmax > 0) || !std::isfinite(edge + cap + rmax))
+        in.fail("the event grid's parameters are not positive numbers");
+    const bool regrid = edge != gridEdge_ || cap != gridCap_ || rmax != rmax_;
+    edm::EventGrid<D> grid = grid_;
+    if (regrid) grid.build(w_.domain, edge, cap);
+    if (in.get<std::uint64_t>() != grid.count()) in.fail("the event grid has another number of cells");
     Sl sl = sl_;
     in.getVector(sl.hot);
     const std::size_t n = sl.hot.size();
@@ -62,10 +74,10 @@ void EdmEngine<D>::loadState(ByteReader& in) {
         const Rec& r = sl.rec[s];
         const std::uint32_t code = r.coll.code, k = code & kIndexMask;
         if (r.idx == kNil) {
-            if (r.cell != grid_.count()) in.fail("a free slot in a cell");
+            if (r.cell != grid.count()) in.fail("a free slot in a cell");
         } else if (r.idx >= nWorld || seen[r.idx]++) {
             in.fail("a slot's particle is out of range or has two slots");
-        } else if (r.cell >= grid_.count()) {
+        } else if (r.cell >= grid.count()) {
             in.fail("a slot's cell is out of range");
         }
         if (((code >> kTypeShift) == kPair && k >= n) || ((code >> kTypeShift) == kWall && k >= walls))
@@ -75,6 +87,9 @@ void EdmEngine<D>::loadState(ByteReader& in) {
     }
     for (std::uint32_t f : freeSlots)
         if (f >= n || sl.rec[f].idx != kNil) in.fail("a free slot is out of range or taken");
+    if ((in.get<std::uint8_t>() != 0) != shells_.on()) in.fail("neighbour shells saved for a run without, or not");
+    edm::Shells<D> shells = shells_;
+    if (shells.on()) shells.load(in, n);
     const auto live = in.get<std::uint64_t>();
     if (live + freeSlots.size() != n) in.fail("the live and free slots do not add up");
     nLive_ = live;
@@ -93,11 +108,23 @@ void EdmEngine<D>::loadState(ByteReader& in) {
     in.expectEnd();
     if (window_ == 0) in.fail("an event-rate window of no events");
 
+    for (std::size_t s = 0; s < n; ++s)
+        if (sl.rec[s].idx != kNil && sl.hot[s].r > rmax * (1 + 1e-12)) in.fail("a particle larger than the grid");
+
+    if (regrid) {  // everything read and checked: the state changes from here on
+        rmax_ = rmax;
+        gridEdge_ = edge;
+        gridCap_ = cap;
+        grid_ = std::move(grid);
+        mesh_.bin(grid_.cells(), rmax_, shells_.half());
+    }
+
     sl_.hot.swap(sl.hot);
     sl_.link.swap(sl.link);
     sl_.rec.swap(sl.rec);
     tc_.setLastCollisions(std::move(last));
     free_.swap(freeSlots);
+    shells_ = std::move(shells);
     queue_.reset(n);
     queue_.build(times);
     grid_.relink(sl_);

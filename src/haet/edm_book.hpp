@@ -11,6 +11,7 @@
 
 #include "edm/observer.hpp"
 #include "haet/zones.hpp"
+#include "io/checkpoint.hpp"
 
 namespace haet {
 
@@ -47,6 +48,12 @@ public:
     }
     /// The World exchanged particles i and j (Particles::swapEntries).
     void swapped(std::uint32_t i, std::uint32_t j);
+
+    /// The book as it is (haet/state.cpp): the volumes are sums in the order the particles came and went, which a
+    /// recount would not repeat to the last bit. loadState, after the engine told the book its grid (restart), for
+    /// event-driven particles [first, n); throws CheckpointError (Corrupt) when the lists do not hold those.
+    void saveState(ByteWriter& out) const;
+    void loadState(ByteReader& in, std::size_t first, std::size_t n);
 
 private:
     static constexpr std::uint32_t kNone = 0xFFFFFFFFu;

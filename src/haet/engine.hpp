@@ -9,6 +9,7 @@
 // are brought to the common time only when they change mode or are written out.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -103,6 +104,20 @@ public:
     void forceModes(const std::vector<std::uint32_t>& toTdm, const std::vector<std::uint32_t>& toEdm);
     /// Switches the automatic mode changes off (tests of a fixed split) or on.
     void freezeModes(bool on) { frozenModes_ = on; }
+    // ---- checkpoints (haet/state.cpp; ARCHITECTURE.md, "Checkpoints") ----
+    /// Whether saveState can hold the whole state (that of the event-driven engine included).
+    bool restartable() const { return edm_->restartable(); }
+    /// Between steps: what the construction resolved from the particles at the start (zone edge, event-grid
+    /// edge, largest radius, skin), the zones' labels, the guard with its bins and near grid, the wall guard's
+    /// cells, the watch list, the per-zone step marks, counters and energy books, then both engines' states and the
+    /// book of the event-driven particles.
+    void saveState(ByteWriter& out) const;
+    /// Replaces the state with a saved one, in an engine made for the same scenario. reloadWorld puts the
+    /// checkpoint's particles into the World: called first, and again after the engines are made anew on them with
+    /// the saved configuration (making them sorts and wraps the store). Throws CheckpointError (Corrupt) for a state
+    /// that does not fit.
+    void loadState(ByteReader& in, const std::function<void()>& reloadWorld);
+
     /// The guard's invariant (tests): event-driven particles in guard cells that are not watched. Zero always,
     /// or such a particle could touch a TDM particle unnoticed. O(N log N).
     std::size_t unwatchedInGuard() const;

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "io/checkpoint.hpp"
 #include "neighbor/cell_grid.hpp"
 #include "world/world.hpp"
 
@@ -40,6 +41,11 @@ public:
     /// of moveTo: exact for the elements listed in its cell (a plane's signed distance: negative beyond it), the
     /// listed reach for all others [m].
     double gap(std::uint32_t cell, const Vec<D>& x, double r) const;
+
+    /// The cells and lists of the last refresh (haet/state.cpp), made at a time a resumed run does not repeat; the
+    /// walls themselves come from collect. loadState throws CheckpointError (Corrupt) for another grid of `cells`.
+    void saveState(ByteWriter& out) const;
+    void loadState(ByteReader& in, std::uint32_t cells);
 
 private:
     struct Item {

@@ -8,6 +8,7 @@
 
 #include "core/particles.hpp"
 #include "geometry/domain.hpp"
+#include "io/checkpoint.hpp"
 #include "neighbor/cell_grid.hpp"
 
 namespace haet {
@@ -50,6 +51,11 @@ public:
     double zoneVolume() const { return cellVolume_; }
     Vec<D> zoneWidth() const { return grid_.width(); }
     Vec<D> origin() const { return grid_.origin(); }
+
+    /// The labels and fractions of the last relabel, which the next one's hysteresis and the steps between read
+    /// (haet/state.cpp); loadState throws CheckpointError (Corrupt) for another number of zones.
+    void saveState(ByteWriter& out) const;
+    void loadState(ByteReader& in);
 
 private:
     /// out[z] = op over the zones within `radius` of z along axis k (periodic axes wrap, each zone once; open

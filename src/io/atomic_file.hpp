@@ -58,6 +58,7 @@ private:
     std::filesystem::path target_;
     std::filesystem::path temp_;
     std::ofstream out_;
+    int error_ = 0;  ///< errno of the first failed write (a later call may change errno before commit reports it)
     bool committed_ = false;
 };
 

@@ -95,8 +95,11 @@ CheckpointFile parseCheckpoint(std::string_view bytes) {
                               "checkpoint of format version " + std::to_string(f.header.version) +
                                   ", newer than this program's " + std::to_string(kCheckpointVersion) +
                                   ": resume it with the version of haet that wrote it");
-    if (f.header.version != kCheckpointVersion)
-        throw corrupt("format version " + std::to_string(f.header.version) + " does not exist");
+    if (f.header.version == 0) throw corrupt("format version 0 does not exist");
+    if (f.header.version != kCheckpointVersion)  // a state whose meaning changed since is not carried over
+        throw corrupt("checkpoint of format version " + std::to_string(f.header.version) +
+                      ", older than this program's " + std::to_string(kCheckpointVersion) +
+                      ": resume it with the version of haet that wrote it");
     const auto length = getRaw<std::uint64_t>(bytes, 12);
     const auto crc = getRaw<std::uint32_t>(bytes, 20);
     const std::size_t have = bytes.size() - kPrefix;

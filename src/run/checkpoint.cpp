@@ -126,6 +126,17 @@ void checkStateKeys(const std::string& saved, const Scenario& sc) {
     if (saved == sc.stateKeys) return;
     const auto a = keyLines(saved), b = keyLines(sc.stateKeys);
     auto differ = [&](const std::string& key, const std::string& was, const std::string& now) {
+        // A file the scenario names (Scenario::stateKeys: "KEY (contents) = fnv1a64 HASH of PATH").
+        constexpr std::string_view contents = " (contents)";
+        if (key.size() > contents.size() && key.compare(key.size() - contents.size(), contents.size(), contents) == 0) {
+            const std::size_t of = now.find(" of ");
+            const std::string file = of != std::string::npos ? now.substr(of + 4) : key;
+            throw CheckpointError(CheckpointFault::OtherScenario,
+                                  fmt::format("{}: the file of {} has changed since the checkpoint was written "
+                                              "(checkpoint: {}, now: {}); a resumed run would not be the same run",
+                                              file, key.substr(0, key.size() - contents.size()),
+                                              was.substr(0, was.find(" of ")), now.substr(0, of)));
+        }
         throw CheckpointError(CheckpointFault::OtherScenario,
                               fmt::format("the checkpoint is of another scenario, or of this one with {} changed "
                                           "(checkpoint: {}, scenario: {}); only duration and [output] may change "

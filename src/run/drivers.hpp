@@ -190,7 +190,7 @@ template <int D>
 class HaetDriver final : public Driver<D> {
 public:
     HaetDriver(World<D>& w, const TdmSettings& ts, const EdmSettings& es, const HaetSettings& hs, std::string dtNote)
-        : eng_(w, ts, es, hs), note_(std::move(dtNote)) {}
+        : w_(w), eng_(w, ts, es, hs), note_(std::move(dtNote)) {}
     const char* method() const override { return "haet"; }
     void advanceTo(double t) override { eng_.advanceTo(t); }
     void synchronise() override { eng_.synchronise(); }
@@ -252,8 +252,20 @@ public:
     void stateChanged() override {
         throw std::invalid_argument("hybrid runs take no change of their particles in place yet");
     }
+    bool restartable() const override { return eng_.restartable(); }
+    void saveState(ByteWriter& out) const override { eng_.saveState(out); }
+    /// The engine loads the World itself, before and after it makes its engines anew (HaetEngine::loadState).
+    void loadState(const CheckpointFile& f) override {
+        ByteReader in = f.section("ENGN");
+        eng_.loadState(in, [&] {
+            ByteReader world = f.section("WRLD");
+            loadWorld(world, w_);
+        });
+        in.expectEnd();
+    }
 
 private:
+    World<D>& w_;
     HaetEngine<D> eng_;
     std::string note_;
 };

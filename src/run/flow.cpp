@@ -108,6 +108,12 @@ void Flow<D>::act(World<D>& world, FlowHost<D>& host, double tol) {
                 break;
             }
         }
+        // A removed particle never comes back: the counters forget it, so that what they hold is bounded by the
+        // particles in the run, not by every particle that ever passed (a long fed run's memory stays flat).
+        if (!which.empty())
+            for (Outlet& o : outlets_)
+                if (!o.def->remove)
+                    for (const std::uint32_t i : which) o.seen.erase(p.id[i]);
         if (!which.empty()) host.remove(which);
     }
     const std::size_t first = p.size();

@@ -51,6 +51,8 @@ public:
     Flow(const Scenario& sc, const World<D>& world, double dt);
 
     bool empty() const { return sc_.inlets.empty() && sc_.outlets.empty(); }
+    /// How many ids outlet k (a counter) remembers as counted: at most the particles in the run.
+    std::size_t remembered(std::size_t k) const { return outlets_[k].seen.size(); }
     /// The next time at which act() has work [s] (infinity: none).
     double nextTime() const;
     /// Does what is due at world.time (to within tol [s]): outlet checks, inlet batches.

@@ -775,6 +775,22 @@ void appendDurationDefaults(const toml::table& root, const Scenario& s, std::str
             line("outlet[" + std::to_string(k + 1) + "].interval", s.outlets[k].interval);
 }
 
+/// The files the scenario names (particle files, STL meshes) by their contents: a changed file is another scenario,
+/// so their hashes are part of what a resume may not change, as "KEY (contents) = fnv1a64 HASH of PATH" lines; a
+/// resume names the file (checkStateKeys). The files were read when the scenario was loaded.
+void appendFileContents(const Scenario& s, std::string& out) {
+    auto line = [&](const std::string& key, const std::string& path) {
+        std::ifstream in(path, std::ios::binary);
+        std::ostringstream bytes;
+        bytes << in.rdbuf();
+        out += key + " (contents) = fnv1a64 " + fnv1a64Hex(bytes.str()) + " of " + path + "\n";
+    };
+    for (std::size_t k = 0; k < s.inserts.size(); ++k)
+        if (!s.inserts[k].file.empty()) line("insert[" + std::to_string(k + 1) + "].file", s.inserts[k].file);
+    for (std::size_t k = 0; k < s.walls.size(); ++k)
+        if (!s.walls[k].file.empty()) line("walls[" + std::to_string(k + 1) + "].file", s.walls[k].file);
+}
+
 }  // namespace
 
 std::string fnv1a64Hex(std::string_view bytes) {
@@ -811,6 +827,7 @@ Scenario parseScenario(std::string_view text, const std::filesystem::path& file,
     s.hash = fnv1a64Hex(text);
     flattenKeys(root, "", s.stateKeys);
     appendDurationDefaults(root, s, s.stateKeys);
+    appendFileContents(s, s.stateKeys);
     s.stateHash = fnv1a64Hex(s.stateKeys);
     s.overrides = std::move(applied);
     return s;

@@ -3,6 +3,7 @@
 // again would list the same pairs in another order after particles moved, and the sums of the pair pass, in list
 // order, would differ in their last bits.
 #include <algorithm>
+#include <cmath>
 
 #include "tdm/engine.hpp"
 
@@ -37,6 +38,10 @@ SurfaceContact<D> getContact(ByteReader& in) {
 template <int D>
 void TdmEngine<D>::saveState(ByteWriter& out) const {
     out.put<std::uint64_t>(w_.particles.tdmCount());
+    // The step and the skin: unless the scenario sets it, the skin follows from the particles at the start (their
+    // largest diameter), which a resumed run's World, after outlets, may no longer hold.
+    out.put<double>(s_.dt);
+    out.put<double>(s_.skin);
     out.put<std::uint64_t>(steps_);
     out.put<std::uint64_t>(rebuilds_);
     out.put<std::uint64_t>(lastSort_);
@@ -73,6 +78,9 @@ void TdmEngine<D>::loadState(ByteReader& in) {
     const auto saved = in.get<std::uint64_t>();
     if (saved != n)
         in.fail(std::to_string(saved) + " time-driven particles saved, " + std::to_string(n) + " in the World");
+    if (in.get<double>() != s_.dt) in.fail("the time step is not this scenario's");
+    const double skin = in.get<double>();
+    if (!(skin >= 0) || !std::isfinite(skin)) in.fail("the skin is not a number");
     steps_ = in.get<std::uint64_t>();
     rebuilds_ = in.get<std::uint64_t>();
     lastSort_ = in.get<std::uint64_t>();
@@ -135,6 +143,7 @@ void TdmEngine<D>::loadState(ByteReader& in) {
     }
     integ_->loadState(in, n);
     in.expectEnd();
+    s_.skin = skin;  // the pair list was built with it
     // The walls where the saved state had them (they follow from the time alone), the derived tables of the pair
     // list made again on first use.
     moveWalls();
