@@ -155,6 +155,15 @@ void checkStateKeys(const std::string& saved, const Scenario& sc) {
 
 namespace {
 
+/// A checkpoint file read and parsed (CheckpointError when it cannot be read or is not whole).
+ResumePoint parsedCheckpoint(const std::filesystem::path& file) {
+    ResumePoint r;
+    r.path = file;
+    r.bytes = readWhole(file);
+    r.file = parseCheckpoint(r.bytes);
+    return r;
+}
+
 void checkScenarioOf(const ResumePoint& r, const Scenario& sc) {
     try {
         ByteReader keys = r.file.section("SCEN");
@@ -172,10 +181,8 @@ void checkScenarioOf(const ResumePoint& r, const Scenario& sc) {
 
 ResumePoint readCheckpoint(const std::filesystem::path& file, const Scenario& sc) {
     ResumePoint r;
-    r.path = file;
     try {
-        r.bytes = readWhole(file);
-        r.file = parseCheckpoint(r.bytes);
+        r = parsedCheckpoint(file);
     } catch (const CheckpointError& e) {
         throw CheckpointError(e.fault(), file.string() + ": " + e.what());
     }
@@ -191,10 +198,8 @@ ResumePoint findCheckpoint(const std::filesystem::path& dir, const Scenario& sc,
     std::string why;
     for (const std::filesystem::path& p : all) {
         ResumePoint r;
-        r.path = p;
         try {
-            r.bytes = readWhole(p);
-            r.file = parseCheckpoint(r.bytes);
+            r = parsedCheckpoint(p);
         } catch (const CheckpointError& e) {
             if (e.fault() == CheckpointFault::FutureVersion)
                 throw CheckpointError(e.fault(), p.string() + ": " + e.what());
