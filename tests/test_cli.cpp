@@ -43,6 +43,24 @@ TEST_F(Cli, CheckValidScenarioPrintsTimeStep) {
     EXPECT_NE(r.out.find("8 "), std::string::npos) << "particle count: " << r.out;
 }
 
+// Hertz with a floor of another material: `check` prints the real restitution of the particles' pairs and of their
+// contacts with each wall material, each calibrated for its own contact (docs/physics.md B.3): sqrt(0.8 0.9) on steel.
+TEST_F(Cli, CheckPrintsTheWallContactsRestitution) {
+    std::string t = haet::testing::replaced(kTiny, "normal = \"linear\"\nduration = 1e-4",
+                                            "normal = \"hertz\"\nimpact_velocity = 0.5");
+    t = haet::testing::replaced(
+        t, "[contact]",
+        "[materials.steel]\ndensity = 7800\nyoung = 2e11\nrestitution = 0.9\nfriction = 0.3\n[contact]");
+    t = haet::testing::replaced(t, "normal = [0, 0, 1]\nmaterial = \"glass\"",
+                                "normal = [0, 0, 1]\nmaterial = \"steel\"");
+    const Result r = haet("check '" + write("hertz.toml", t).string() + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("material   glass: restitution of the soft law 0.80000"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("material   glass on walls of steel: restitution of the soft law 0.84853"), std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("steel on walls"), std::string::npos) << "steel has no particles: " << r.out;
+}
+
 TEST_F(Cli, UnknownKey) {
     expectBadInput(edit("friction = 0.5", "friction = 0.5\ncolour = \"green\""), "colour", "materials.glass.colour");
 }

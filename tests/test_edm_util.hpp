@@ -25,6 +25,7 @@ inline ContactSetup edmContact(double e, double mu = 0, double beta0 = -1, int n
     c.mu = mu;
     c.beta0 = beta0;
     cs.table.assign(nMaterials * nMaterials, c);
+    cs.wallTable = cs.table;
     cs.contactTime = tc;
     return cs;
 }

@@ -75,6 +75,7 @@ void expectLanesMatchOneByOne(const Scenario& sc, int threads, bool oneLaw = fal
     }
     if (oneLaw)
         for (PairCoeffs& c : cs.table) c = cs.table[0];
+    cs.wallTable = cs.table;  // the walls' contacts with the same Hertz coefficients
     ASSERT_EQ(uniformForceLaw(cs.table.data(), cs.table.size()), oneLaw);
     const int before = omp_get_max_threads();
     omp_set_num_threads(threads);

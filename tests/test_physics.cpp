@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "contact/setup.hpp"
+#include "edm/engine.hpp"
 #include "physics_util.hpp"
 #include "scenario/loader.hpp"
 #include "tdm/engine.hpp"
@@ -315,9 +316,12 @@ HeadOnMeasure hertzHeadOn(const Scenario& sc, const HertzMaterial& hm, double v,
             w.particles.add(n * (-a - 0.5 * gap), n * (0.5 * v), Ang<3>::zero(), a, hm.density, 0, 1);
         }
     };
-    // The set-up sizes t_c from the particles; the positions do not matter for it.
+    // The set-up sizes t_c from the particles; the positions do not matter for it. The scene declares its wall, so
+    // that the set-up calibrates the particle-wall contact (ContactSetup::wallTable).
     place(0);
-    w.contact = buildContactSetup<3>(sc, testing::statsOf(w.particles, 1));
+    Scenario scene = sc;
+    if (wall) scene.walls.push_back(WallDef{});
+    w.contact = buildContactSetup<3>(scene, testing::statsOf(w.particles, 1));
     s.dt = w.contact.contactTime / stepsPerContact;
     w.particles = Particles<3>{};
     w.walls.clear();
@@ -450,6 +454,143 @@ TEST(HertzDamped, TsujiRestitutionContactEndsAtZeroOverlap) { checkTsuji(true); 
 // overlapping) must give the material's e within the fit's 0.01 as well: `restitution` is the material's e
 // (docs/scenario.md), and for the viscoelastic law the set-up solves A* with the clipping included.
 TEST(HertzDamped, TsujiRestitutionDefaultContactEnd) { checkTsuji(false); }
+
+// The damped Hertz laws give the restitution asked at impact_velocity under either contact-ending rule, for pairs and
+// for walls: a wall contact (m_eff = m, R_eff = R) has a calibration of its own (docs/physics.md B.3). The engine,
+// finely stepped (its own error at 2000 steps per contact is below 2e-5), measures e; the set-up's restitution (the
+// event-driven engine's) is the soft law's to the bisection's precision.
+TEST(HertzDamped, RestitutionAskedIsObtainedPairsAndWalls) {
+    const HertzMaterial hm;
+    const double v = 0.5;
+    struct Law {
+        HertzDamping damping;
+        bool attraction;
+        const char* name;
+    };
+    for (const Law& law :
+         {Law{HertzDamping::Viscoelastic, false, "viscoelastic"},
+          Law{HertzDamping::Viscoelastic, true, "viscoelastic, attraction"}, Law{HertzDamping::Tsuji, false, "Tsuji"},
+          Law{HertzDamping::Tsuji, true, "Tsuji, attraction"}})
+        for (double e : {0.1, 0.3, 0.6, 0.8, 0.95, 1.0}) {
+            Scenario sc = hertzScenario(hm, law.damping, e, v);
+            sc.contact.attraction = law.attraction;
+            for (bool wall : {false, true}) {
+                ContactSetup setup;
+                const HeadOnMeasure m = hertzHeadOn(sc, hm, v, wall, IntegratorKind::Verlet, 2000, &setup);
+                const std::string what =
+                    std::string(law.name) + ", e = " + std::to_string(e) + (wall ? ", wall" : ", pair");
+                EXPECT_NEAR(m.restitution, e, 1e-4) << what;
+                EXPECT_NEAR((wall ? setup.wallPair(0, 0) : setup.pair(0, 0)).restitution, e, 1e-6) << what;
+                char got[32];
+                std::snprintf(got, sizeof got, "%.8f", m.restitution);
+                RecordProperty(what, got);
+            }
+        }
+}
+
+// One material for the particles and the wall: both contacts get its e, each with its own A*. The viscoelastic
+// collision depends on A*, the speed and alpha = rho / m_eff only through A* alpha^(2/5) v^(1/5) (B.3), and alpha
+// of a pair (m/2, R/2) is sqrt(2) times the wall's (m, R): A*_wall = 2^(1/5) A*_pair. The pair's A* on the wall
+// (what one shared entry gave) misses e.
+TEST(HertzDamped, MaterialOfParticlesAndWallGetsItsRestitutionInBoth) {
+    const HertzMaterial hm;
+    const double e = 0.6, v = 1.0;
+    const Scenario sc = hertzScenario(hm, HertzDamping::Viscoelastic, e, v);
+    ContactSetup setup;
+    const HeadOnMeasure wall = hertzHeadOn(sc, hm, v, true, IntegratorKind::Verlet, 2000, &setup);
+    const HeadOnMeasure pair = hertzHeadOn(sc, hm, v, false, IntegratorKind::Verlet, 2000);
+    EXPECT_NEAR(wall.restitution, e, 1e-4);
+    EXPECT_NEAR(pair.restitution, e, 1e-4);
+    const PairCoeffs& cp = setup.pair(0, 0);
+    const PairCoeffs& cw = setup.wallPair(0, 0);
+    EXPECT_NEAR(cw.dissipationTime / cp.dissipationTime, std::pow(2.0, 0.2), 1e-6);
+    EXPECT_NEAR(cp.restitution, e, 1e-6);
+    EXPECT_NEAR(cw.restitution, e, 1e-6);
+    const HeadOnResult shared =
+        simulateHeadOn(NormalLaw::Hertz, HertzDamping::Viscoelastic, cp, hm.mass(), hm.radius, v, false);
+    EXPECT_GT(shared.restitution - e, 0.02) << "the pair's A* on a wall";
+}
+
+// Particles of one material against a wall of another: the wall table's entry (particle x wall) is calibrated with the
+// particle's mean mass and radius, and the event-driven engine bounces a sphere off the wall with that entry's
+// restitution, the soft law's. With A* given for both materials nothing is solved: the wall contact's e then differs
+// from the pair's, and the hard wall must give the wall's.
+TEST(HertzDamped, WallTableServesBothEngines) {
+    const HertzMaterial hm;
+    Scenario sc = hertzScenario(hm, HertzDamping::Viscoelastic, 0.7, 1.0);
+    MaterialDef steel = sc.materials[0];
+    steel.name = "steel";
+    steel.young = 2e11;
+    steel.poisson = 0.3;
+    steel.restitution = 0.9;
+    sc.materials.push_back(steel);
+    WallDef floor;
+    floor.material = 1;
+    sc.walls.push_back(floor);
+    World<3> w;
+    w.domain = testing::openBox<3>(0.05);
+    const Vec<3> n{{0, 0, 1}};
+    const double start = 1.01 * hm.radius;  // 10 um from the wall at 1 m/s
+    w.particles.add(n * start, n * -1.0, Ang<3>::zero(), hm.radius, hm.density, 0, 0);
+    w.walls.push_back(Wall<3>::plane(Vec<3>::zero(), n, Vec<3>::zero(), 1));
+    w.contact = buildContactSetup<3>(sc, testing::statsOf(w.particles, 2));
+    const double e = std::sqrt(0.7 * 0.9);
+    EXPECT_NEAR(w.contact.wallPair(0, 1).restitution, e, 1e-6);
+    EXPECT_NEAR(w.contact.pair(0, 1).restitution, e, 1e-6);
+    EXPECT_NE(w.contact.wallPair(0, 1).dissipationTime, w.contact.pair(0, 1).dissipationTime);
+    // steel is a wall's material only: no particle of it meets a wall, its row keeps the pair's values
+    EXPECT_EQ(w.contact.wallPair(1, 0).dissipationTime, w.contact.pair(1, 0).dissipationTime);
+    // The EDM's wall restitution is the wall entry's
+    sc.materials[0].dissipationTime = sc.materials[1].dissipationTime = w.contact.pair(0, 1).dissipationTime;
+    World<3> given = w;
+    given.contact = buildContactSetup<3>(sc, testing::statsOf(w.particles, 2));
+    const double eWall = given.contact.wallPair(0, 1).restitution;
+    EXPECT_NEAR(given.contact.pair(0, 1).restitution, e, 1e-6);
+    EXPECT_GT(eWall, e + 0.01) << "the pair's A* damps a wall contact less";
+    EdmEngine<3> eng(given, EdmSettings{});
+    eng.advanceTo(1e-4);
+    EXPECT_EQ(eng.collisions(), 1u);
+    EXPECT_NEAR(given.particles.v[0][2], eWall, 1e-12);
+    // ... and the soft law, integrated by the engine, gives the same e
+    TdmSettings ts;
+    ts.integrator = IntegratorKind::Verlet;
+    ts.dt = given.contact.contactTime / 2000;
+    ts.skin = hm.radius;
+    ts.sortEvery = 0;
+    World<3> soft = w;
+    soft.contact = given.contact;
+    TdmEngine<3> tdm(soft, ts);
+    while (soft.particles.x[0][2] < start || soft.particles.v[0][2] < 0) tdm.step();
+    EXPECT_NEAR(soft.particles.v[0][2], eWall, 1e-4);
+}
+
+// The time-step rule's contact time covers the wall contacts: large light spheres (r = 3 mm, 100 kg/m^3) against a
+// wall touch for a shorter time than the lightest pair, which pairs the lightest mass with the smallest radius of
+// another, denser material (1 mm, 8000 kg/m^3): (m^2/R)^(1/5) of the wall contact is the smaller (B.3).
+TEST(HertzDamped, ContactTimeCountsWallContacts) {
+    ContactModelDef cd;
+    cd.normal = NormalLaw::Hertz;
+    cd.hertzDamping = HertzDamping::None;
+    cd.tangential = TangentialLaw::None;
+    MaterialProps m;
+    m.young = 1e7;
+    m.poisson = 0.3;
+    auto stat = [](double r, double density) {
+        MaterialStats st;
+        st.count = 1;
+        st.meanRadius = st.minRadius = r;
+        st.meanMass = st.minMass = density * 4.0 / 3.0 * kPi * r * r * r;
+        return st;
+    };
+    const std::vector<MaterialStats> stats{stat(1e-3, 8000), stat(3e-3, 100)};
+    const ContactSetup s = buildContactSetup<3>(cd, {m, m}, stats, {true, true}, {false, true});
+    const double eEff = m.young / (2 * (1 - m.poisson * m.poisson)), mb = stats[1].minMass;
+    const double wall = 2.868 * std::pow(mb * mb / (3e-3 * eEff * eEff * cd.impactVelocity), 0.2);
+    const double pair = 2.868 * std::pow(0.25 * mb * mb / (0.5e-3 * eEff * eEff * cd.impactVelocity), 0.2);
+    ASSERT_LT(wall, pair);
+    EXPECT_NEAR(s.contactTime, wall, 1e-12 * wall);
+    EXPECT_NE(s.contactTimeNote.find("a wall contact"), std::string::npos) << s.contactTimeNote;
+}
 
 // ------------------------------------------------------------------------------------------------------------
 // 4. Settling in a closed box

@@ -29,7 +29,8 @@ double normalForce(NormalLaw law, HertzDamping damping, const PairCoeffs& c, dou
 
 /// Finds the damping coefficient x >= 0 of a law for which a head-on collision at speed v gives
 /// restitution e, with the contact-ending rule in force (bisection: e falls as x grows). `set` stores x in the
-/// coefficients; `scale` is a first guess of its size.
+/// coefficients; `scale` is a first guess of its size. NaN when even the undamped collision does not end; when e
+/// cannot be reached the result gives another e, which the caller sees in the measured restitution.
 template <class Set>
 double solveDamping(NormalLaw normal, const PairCoeffs& base, HertzDamping law, Set set, double scale, double e,
                     double meff, double reff, double v, bool attraction) {
@@ -37,19 +38,19 @@ double solveDamping(NormalLaw normal, const PairCoeffs& base, HertzDamping law, 
     PairCoeffs c = base;
     auto restitutionAt = [&](double x) {
         set(c, x);
-        return simulateHeadOn(normal, law, c, meff, reff, v, attraction).restitution;
+        return simulateHeadOn(normal, law, c, meff, reff, v, attraction, e).restitution;
     };
+    if (std::isnan(restitutionAt(0))) return std::numeric_limits<double>::quiet_NaN();  // no collision to calibrate on
+    // A NaN restitution of a damped collision: the bodies stick (attraction = true lets the damping hold them), e
+    // is 0 in effect, below the e asked.
     double lo = 0, hi = scale;
-    for (double r = restitutionAt(hi); r >= e || std::isnan(r); r = restitutionAt(hi)) {
-        if (std::isnan(r)) return std::numeric_limits<double>::quiet_NaN();  // no collision to calibrate on
+    for (double r = restitutionAt(hi); r >= e; r = restitutionAt(hi)) {
         hi *= 2;
         if (hi > 1e6 * scale) return hi;
     }
     for (int it = 0; it < 60; ++it) {
         const double mid = 0.5 * (lo + hi);
-        const double r = restitutionAt(mid);
-        if (std::isnan(r)) return r;
-        (r > e ? lo : hi) = mid;
+        (restitutionAt(mid) > e ? lo : hi) = mid;
     }
     return 0.5 * (lo + hi);
 }
@@ -57,7 +58,7 @@ double solveDamping(NormalLaw normal, const PairCoeffs& base, HertzDamping law, 
 }  // namespace
 
 HeadOnResult simulateHeadOn(NormalLaw law, HertzDamping damping, const PairCoeffs& c, double meff, double reff,
-                            double v, bool attraction) {
+                            double v, bool attraction, double stopBelow) {
     // Overlap equation m_eff delta'' = -F(delta, delta'), delta(0) = 0, delta'(0) = v.
     // Step from the elastic estimate of the contact time.
     constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -88,6 +89,12 @@ HeadOnResult simulateHeadOn(NormalLaw law, HertzDamping damping, const PairCoeff
         if (dn <= 0) {  // overlap returned to zero: interpolate the crossing linearly
             const double frac = d / (d - dn);
             return {-(dd + frac * (ddn - dd)) / v, t + frac * h, dmax};
+        }
+        if (attraction && stopBelow > 0 && ddn < 0 && -ddn < stopBelow * v &&
+            normalForce(law, damping, c, dn, ddn, meff, reff) < 0) {
+            // Separating and pulled back: the force stays attractive until the overlap ends (where F = 0 while
+            // separating, dF/dt < 0 for every law here), so the speed only falls: e < -delta'/v already.
+            return {-ddn / v, t + h, dmax};
         }
         if (!attraction && step > 0) {
             const double fOld = normalForce(law, damping, c, d, dd, meff, reff);
@@ -175,15 +182,13 @@ void setUpHertz(PairCoeffs& c, const ContactModelDef& cd, const PairRef& p) {
     const double eb = (1 - p.b.poisson * p.b.poisson) / p.b.young;
     c.hertzK = (4.0 / 3.0) / (ea + eb);
     if (cd.hertzDamping == HertzDamping::Tsuji) {
-        // Tsuji's alpha(e) fit assumes the contact ends at zero overlap; with the force clipped at zero the same
-        // alpha gives a larger e. Solve for the alpha that gives e under the rule in force, starting from the fit
-        // (the collision is speed-independent for this law).
-        c.tsujiAlpha =
-            cd.attraction
-                ? tsujiAlpha(p.e)
-                : solveDamping(
-                      NormalLaw::Hertz, c, HertzDamping::Tsuji, [](PairCoeffs& pc, double x) { pc.tsujiAlpha = x; },
-                      std::max(tsujiAlpha(p.e), 1e-3), p.e, p.meffRef, p.reffRef, cd.impactVelocity, cd.attraction);
+        // Tsuji's polynomial alpha(e) fit is good to about 0.01 in e, and assumes the contact ends at zero overlap;
+        // with the force clipped at zero the same alpha gives a larger e still. So alpha is solved for, under the
+        // rule in force, starting from the fit. The collision does not depend on the speed, the mass or the
+        // radius for this law (its damping scales as sqrt(m_eff k_H)), so pairs and walls share one alpha.
+        c.tsujiAlpha = solveDamping(
+            NormalLaw::Hertz, c, HertzDamping::Tsuji, [](PairCoeffs& pc, double x) { pc.tsujiAlpha = x; },
+            std::max(tsujiAlpha(p.e), 1e-3), p.e, p.meffRef, p.reffRef, cd.impactVelocity, cd.attraction);
     } else if (cd.hertzDamping == HertzDamping::Viscoelastic) {
         if (p.a.dissipationTime && p.b.dissipationTime) {
             c.dissipationTime = 0.5 * (*p.a.dissipationTime + *p.b.dissipationTime);
@@ -226,11 +231,71 @@ polygon::PolygonCoeffs polygonCoeffs(const ContactModelDef& cd, const PairRef& p
     return pc;
 }
 
+/// Makes the coefficients of contacts between materials a and b for one reference contact (m_eff, R_eff): a pair of
+/// particles, or a particle and a wall (docs/physics.md B.3). Hertz calibrations with the same inputs are done
+/// once (`calibrated`: one head-on integration per calibration, some 10^6 force evaluations).
+template <int D>
+class CoeffMaker {
+public:
+    CoeffMaker(const ContactModelDef& cd, const ContactSetup& s) : cd_(cd), s_(s) {}
+
+    /// The coefficients of a contact of a with b; `calibrate`: the Hertz damping is solved for and the real
+    /// restitution measured (else the mixed values without calibration, and restitution e_ab).
+    PairCoeffs make(const MaterialProps& ma, const MaterialProps& mb, double meff, double reff, bool calibrate,
+                    HeadOnResult& h) {
+        const double e = std::sqrt(ma.restitution * mb.restitution);
+        const PairRef p{ma, mb, e, std::log(e), meff, reff};
+        PairCoeffs c;
+        c.mu = std::sqrt(ma.friction * mb.friction);
+        c.beta0 = 0.5 * (ma.tangentialRestitution + mb.tangentialRestitution);
+        const double ea = (1 - ma.poisson * ma.poisson) / ma.young, eb = (1 - mb.poisson * mb.poisson) / mb.young;
+        if (cd_.normal == NormalLaw::Linear) {
+            setUpLinear(c, cd_, p);
+        } else if (calibrate) {
+            // Tsuji's collision does not depend on m_eff and R_eff (setUpHertz): pairs and walls share one alpha.
+            const bool tsuji = cd_.hertzDamping == HertzDamping::Tsuji;
+            const std::array<double, 6> key{ea + eb,
+                                            e,
+                                            tsuji ? 0 : meff,
+                                            tsuji ? 0 : reff,
+                                            ma.dissipationTime.value_or(-1),
+                                            mb.dissipationTime.value_or(-1)};
+            if (const auto it = calibrated_.find(key); it != calibrated_.end()) {
+                c.hertzK = it->second.hertzK;
+                c.tsujiAlpha = it->second.tsujiAlpha;
+                c.dissipationTime = it->second.dissipationTime;
+            } else {
+                setUpHertz(c, cd_, p);
+                calibrated_.emplace(key, c);
+            }
+        } else {
+            c.hertzK = (4.0 / 3.0) / (ea + eb);
+        }
+        if (cd_.tangential == TangentialLaw::Spring) setUpSpring<D>(c, cd_);
+        // The restitution the soft law really produces (contact-ending rule included), for the EDM.
+        c.restitution = e;
+        h = {e, 0, 0};
+        // (A polygon-only scene may leave the linear law without coefficients: nothing to simulate.)
+        const bool haveDiskLaw = cd_.normal == NormalLaw::Hertz || cd_.kn || cd_.duration;
+        if (haveDiskLaw && calibrate) {
+            h = simulateHeadOn(s_.normal, s_.hertzDamping, c, meff, reff, cd_.impactVelocity, cd_.attraction);
+            c.restitution = h.restitution;
+        }
+        return c;
+    }
+
+private:
+    const ContactModelDef& cd_;
+    const ContactSetup& s_;
+    std::map<std::array<double, 6>, PairCoeffs> calibrated_;
+};
+
 }  // namespace
 
 template <int D>
 ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<MaterialProps>& materials,
-                               const std::vector<MaterialStats>& stats, const std::vector<bool>& used) {
+                               const std::vector<MaterialStats>& stats, const std::vector<bool>& used,
+                               const std::vector<bool>& wallMaterials) {
     ContactSetup s;
     s.normal = cd.normal;
     s.hertzDamping = cd.normal == NormalLaw::Hertz ? cd.hertzDamping : HertzDamping::None;
@@ -239,6 +304,7 @@ ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<Mate
     const int nm = static_cast<int>(materials.size());
     s.nMaterials = nm;
     s.table.resize(nm * nm);
+    s.wallTable.resize(nm * nm);
     s.polygonTable.resize(nm * nm);
 
     // Reference particle of each material (materials without particles borrow the overall mean).
@@ -260,78 +326,101 @@ ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<Mate
     }
     auto ref = [&](int m) { return (m < (int)stats.size() && stats[m].count > 0) ? stats[m] : all; };
 
+    // The deepest reference collision, and the first whose calibrated damping misses the restitution asked (the
+    // bisection meets it to ~1e-15; a miss means the law cannot give that e under the contact-ending rule).
+    const bool solvesDamping = cd.normal == NormalLaw::Hertz && cd.hertzDamping != HertzDamping::None;
+    auto record = [&](const HeadOnResult& h, const PairCoeffs& c, const MaterialProps& ma, const MaterialProps& mb,
+                      double meff, double reff, int a, int b, bool wall) {
+        double ratio = std::isnan(h.restitution) ? std::numeric_limits<double>::infinity() : h.maxOverlap / reff;
+        const double e = std::sqrt(ma.restitution * mb.restitution);
+        const bool userDamping =
+            cd.hertzDamping == HertzDamping::Viscoelastic && ma.dissipationTime && mb.dissipationTime;
+        if (solvesDamping && !userDamping && e < 1 && !(std::abs(h.restitution - e) <= 1e-6)) {
+            // The law cannot give e here. A collision that does not end although the elastic one does is the
+            // damping's doing (the bodies stick), not the modulus'.
+            PairCoeffs elastic = c;
+            elastic.dissipationTime = elastic.tsujiAlpha = 0;
+            const HeadOnResult he =
+                simulateHeadOn(NormalLaw::Hertz, HertzDamping::None, elastic, meff, reff, cd.impactVelocity, false);
+            if (!std::isnan(he.restitution)) {
+                if (std::isnan(h.restitution)) ratio = he.maxOverlap / reff;
+                if (s.calibrationMiss.a < 0) s.calibrationMiss = {a, b, wall, e, h.restitution};
+            }
+        }
+        if (!(ratio <= s.worstHeadOn.overlapRatio)) s.worstHeadOn = {ratio, a, b, wall};
+    };
+
     // The table is symmetric (every mixing rule is), so each pair is set up once. A pair of which a material is
     // unused (no particle, no wall, no insert) keeps the mixed values without the head-on calibration, which costs
     // some 10^6 force evaluations per pair (200 materials took 55 s); pairs with the same inputs share one.
     auto isUsed = [&](int m) { return used.empty() || used[m]; };
-    std::map<std::array<double, 6>, PairCoeffs> calibrated;
+    auto isWall = [&](int m) { return wallMaterials.empty() || wallMaterials[m]; };
+    // A material of particles: used, and not only a wall's.
+    auto isParticle = [&](int m) {
+        return isUsed(m) && (wallMaterials.empty() || !wallMaterials[m] || (m < (int)stats.size() && stats[m].count));
+    };
+    CoeffMaker<D> maker(cd, s);
     for (int a = 0; a < nm; ++a) {
         for (int b = a; b < nm; ++b) {
-            const MaterialProps& ma = materials[a];
-            const MaterialProps& mb = materials[b];
             const MaterialStats ra = ref(a), rb = ref(b);
-            const double e = std::sqrt(ma.restitution * mb.restitution);
-            const PairRef p{ma,
-                            mb,
-                            e,
-                            std::log(e),
-                            ra.meanMass * rb.meanMass / (ra.meanMass + rb.meanMass),
-                            ra.meanRadius * rb.meanRadius / (ra.meanRadius + rb.meanRadius)};
-            PairCoeffs c;
-            c.mu = std::sqrt(ma.friction * mb.friction);
-            c.beta0 = 0.5 * (ma.tangentialRestitution + mb.tangentialRestitution);
-            // (A polygon-only scene may leave the linear law without coefficients: nothing to simulate.)
-            const bool haveDiskLaw = cd.normal == NormalLaw::Hertz || cd.kn || cd.duration;
+            const double meff = ra.meanMass * rb.meanMass / (ra.meanMass + rb.meanMass);
+            const double reff = ra.meanRadius * rb.meanRadius / (ra.meanRadius + rb.meanRadius);
             const bool pairUsed = isUsed(a) && isUsed(b);
-            if (cd.normal == NormalLaw::Linear) {
-                setUpLinear(c, cd, p);
-            } else if (pairUsed) {
-                const double ea = (1 - ma.poisson * ma.poisson) / ma.young,
-                             eb = (1 - mb.poisson * mb.poisson) / mb.young;
-                const std::array<double, 6> key{
-                    ea + eb, e, p.meffRef, p.reffRef, ma.dissipationTime.value_or(-1), mb.dissipationTime.value_or(-1)};
-                if (const auto it = calibrated.find(key); it != calibrated.end()) {
-                    c.hertzK = it->second.hertzK;
-                    c.tsujiAlpha = it->second.tsujiAlpha;
-                    c.dissipationTime = it->second.dissipationTime;
-                } else {
-                    setUpHertz(c, cd, p);
-                    calibrated.emplace(key, c);
-                }
-            } else {
-                const double ea = (1 - ma.poisson * ma.poisson) / ma.young,
-                             eb = (1 - mb.poisson * mb.poisson) / mb.young;
-                c.hertzK = (4.0 / 3.0) / (ea + eb);
-            }
-            if (cd.tangential == TangentialLaw::Spring) setUpSpring<D>(c, cd);
-            // The restitution the soft law really produces (contact-ending rule included), for the EDM.
-            c.restitution = e;
-            if (haveDiskLaw && pairUsed) {
-                const HeadOnResult h =
-                    simulateHeadOn(s.normal, s.hertzDamping, c, p.meffRef, p.reffRef, cd.impactVelocity, cd.attraction);
-                c.restitution = h.restitution;
-                const double ratio =
-                    std::isnan(h.restitution) ? std::numeric_limits<double>::infinity() : h.maxOverlap / p.reffRef;
-                if (!(ratio <= s.worstHeadOn.overlapRatio)) s.worstHeadOn = {ratio, a, b};
-            }
+            HeadOnResult h;
+            const PairCoeffs c = maker.make(materials[a], materials[b], meff, reff, pairUsed, h);
+            if (pairUsed) record(h, c, materials[a], materials[b], meff, reff, a, b, false);
             s.table[a * nm + b] = s.table[b * nm + a] = c;
+            const double e = std::sqrt(materials[a].restitution * materials[b].restitution);
+            const PairRef p{materials[a], materials[b], e, std::log(e), meff, reff};
             s.polygonTable[a * nm + b] = s.polygonTable[b * nm + a] = polygonCoeffs(cd, p, c.mu);
         }
     }
+    // Particle-wall contacts (row: the particle's material, column: the wall's): a wall is a partner of infinite
+    // mass and radius, so the reference contact is one mean particle of the material against a flat wall, m_eff = m
+    // and R_eff = R (docs/physics.md B.3). The viscoelastic law's e depends on m_eff, R_eff and the speed: its A*
+    // is solved for this contact on its own. Combinations that cannot touch keep the pair's coefficients.
+    s.wallTable = s.table;
+    for (int a = 0; a < nm; ++a) {
+        if (!isParticle(a)) continue;
+        const MaterialStats ra = ref(a);
+        for (int b = 0; b < nm; ++b) {
+            if (!isUsed(b) || !isWall(b)) continue;
+            HeadOnResult h;
+            const PairCoeffs c = maker.make(materials[a], materials[b], ra.meanMass, ra.meanRadius, true, h);
+            record(h, c, materials[a], materials[b], ra.meanMass, ra.meanRadius, a, b, true);
+            s.wallTable[a * nm + b] = c;
+        }
+    }
 
-    // Contact time for the time-step rule: the lightest pair (two smallest particles), and a wall contact.
+    // Contact time for the time-step rule: the lightest pair (two smallest particles), and the wall contacts (the
+    // lightest particle of each material against each wall material, m_eff = m, R_eff = R).
     const double meffMin = 0.5 * all.minMass;
     const double reffMin = 0.5 * all.minRadius;
     double tc = std::numeric_limits<double>::infinity();
     // The linear law from (e, t_c) with the force clipped: its damping is solved for (linearClippedDamping), so
     // its damped period is no longer t_c; the time-step rule keeps the t_c the user gave.
     const bool givenDuration = cd.normal == NormalLaw::Linear && !cd.kn && cd.duration && !cd.attraction;
+    auto contactTime = [&](const PairCoeffs& c, double meff, double reff) {
+        return givenDuration                    ? *cd.duration
+               : cd.normal == NormalLaw::Linear ? linearContactTime(c, meff)
+                                                : hertzContactTime(c, meff, reff, cd.impactVelocity);
+    };
     for (int k = 0; k < nm * nm; ++k) {
         if (!isUsed(k / nm) || !isUsed(k % nm)) continue;
-        const PairCoeffs& c = s.table[k];
-        tc = std::min(tc, givenDuration                    ? *cd.duration
-                          : cd.normal == NormalLaw::Linear ? linearContactTime(c, meffMin)
-                                                           : hertzContactTime(c, meffMin, reffMin, cd.impactVelocity));
+        tc = std::min(tc, contactTime(s.table[k], meffMin, reffMin));
+    }
+    bool wallShortest = false;
+    for (int a = 0; a < nm; ++a) {
+        if (!isParticle(a)) continue;
+        const MaterialStats ra = ref(a);
+        for (int b = 0; b < nm; ++b) {
+            if (!isUsed(b) || !isWall(b)) continue;
+            const double t = contactTime(s.wallTable[a * nm + b], ra.minMass, ra.minRadius);
+            if (t < tc) {
+                tc = t;
+                wallShortest = true;
+            }
+        }
     }
     s.contactTime = tc;
     s.diskContactTime = tc;
@@ -341,6 +430,7 @@ ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<Mate
     else
         s.contactTimeNote =
             "Hertz: t_c = 2.868 (m_eff^2/(R_eff E_eff^2 v))^(1/5) of the smallest pair at impact_velocity";
+    if (wallShortest && !givenDuration) s.contactTimeNote += " (a wall contact: the shortest)";
 
     // Polygons: the thesis rule dt = (pi/10) sqrt(m_min/Y) (docs/physics.md F.3), with the stiffest pair's Y; their
     // contact time is about ten such steps. The rule assumes light damping: the Gear corrector sees the damping
@@ -372,8 +462,10 @@ ContactSetup buildContactSetup(const ContactModelDef& cd, const std::vector<Mate
 }
 
 template ContactSetup buildContactSetup<2>(const ContactModelDef&, const std::vector<MaterialProps>&,
-                                           const std::vector<MaterialStats>&, const std::vector<bool>&);
+                                           const std::vector<MaterialStats>&, const std::vector<bool>&,
+                                           const std::vector<bool>&);
 template ContactSetup buildContactSetup<3>(const ContactModelDef&, const std::vector<MaterialProps>&,
-                                           const std::vector<MaterialStats>&, const std::vector<bool>&);
+                                           const std::vector<MaterialStats>&, const std::vector<bool>&,
+                                           const std::vector<bool>&);
 
 }  // namespace haet

@@ -30,8 +30,9 @@ Vec<D> impulseWithHop(const CollisionBody<D>& b1, const CollisionBody<D>& b2, co
 }  // namespace
 
 template <int D>
-CollisionLaw EdmEngine<D>::lawFor(int matA, int matB, bool elastic) const {
-    const PairCoeffs& c = w_.contact.pair(matA, matB);
+CollisionLaw EdmEngine<D>::lawFor(int matA, int matB, bool wall, bool elastic) const {
+    // A wall's restitution is the one the soft law gives a particle against it (its own calibration, m_eff = m).
+    const PairCoeffs& c = wall ? w_.contact.wallPair(matA, matB) : w_.contact.pair(matA, matB);
     CollisionLaw law;
     law.mu = c.mu;
     if (elastic) {
@@ -111,7 +112,7 @@ void EdmEngine<D>::collidePair(std::uint32_t a, std::uint32_t b, double t) {
     sl_.advance(b, t);
     const bool elastic = tc_.elastic(a, fb ? kNil : b, t);
     bool hop = false;
-    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(ma, mb, elastic), approaching, gn, uRest, hop);
+    const Vec<D> P = impulseWithHop(b1, b2, n, lawFor(ma, mb, false, elastic), approaching, gn, uRest, hop);
     const double before = kineticEnergy(b1) + kineticEnergy(b2);
     applyImpulse(b1, b2, n, P);
     stats_.dissipated += before - kineticEnergy(b1) - kineticEnergy(b2);
@@ -148,7 +149,7 @@ typename EdmEngine<D>::WallHit EdmEngine<D>::wallImpulse(std::uint32_t s, double
     WallHit h;
     sl_.advance(s, t);
     h.elastic = tc_.elastic(s, kNil, t);
-    h.P = impulseWithHop(b1, b2, n, lawFor(ma, wallMaterial, h.elastic), gn < 0, gn, uRest, h.hop);
+    h.P = impulseWithHop(b1, b2, n, lawFor(ma, wallMaterial, true, h.elastic), gn < 0, gn, uRest, h.hop);
     const double before = kineticEnergy(b1);
     applyImpulse(b1, b2, n, h.P);
     stats_.dissipated += before - kineticEnergy(b1);
@@ -220,7 +221,7 @@ void EdmEngine<D>::collideMesh(std::uint32_t s, std::uint32_t e, double t) {
 
 // The members defined here, for both dimensions (the class itself is instantiated in edm/engine.cpp).
 #define HAET_EDM_COLLIDE(D)                                                                                          \
-    template CollisionLaw EdmEngine<D>::lawFor(int, int, bool) const;                                                \
+    template CollisionLaw EdmEngine<D>::lawFor(int, int, bool, bool) const;                                          \
     template bool EdmEngine<D>::smoothPair(int, int) const;                                                          \
     template void EdmEngine<D>::notify(double, std::uint32_t, std::uint32_t, bool, bool, bool, const Vec<D>&,        \
                                        std::uint32_t);                                                               \

@@ -23,7 +23,8 @@ template <int D>
 EdmEngine<D>::EdmEngine(World<D>& world, const EdmSettings& settings, EdmObserver<D>* observer)
     : w_(world), s_(settings) {
     const ContactSetup& cs = w_.contact;
-    if (cs.nMaterials <= 0 || cs.table.size() < static_cast<std::size_t>(cs.nMaterials * cs.nMaterials))
+    if (cs.nMaterials <= 0 || cs.table.size() < static_cast<std::size_t>(cs.nMaterials * cs.nMaterials) ||
+        cs.wallTable.size() < cs.table.size())
         throw std::invalid_argument("event-driven engine: the world has no contact table (world.contact)");
     if (s_.tcTime < 0) throw std::invalid_argument("event-driven engine: tcTime must be >= 0");
     if (s_.maxEventRate < 0) throw std::invalid_argument("event-driven engine: maxEventRate must be >= 0");

@@ -263,7 +263,8 @@ private:
     }
     [[gnu::noinline]] void checkRate(double t);
     bool frozen(std::uint32_t s) const { return sl_.frozen(s); }  // also true for a free slot
-    CollisionLaw lawFor(int matA, int matB, bool elastic) const;
+    /// The collision law of materials (matA, matB); wall: matA a particle's, matB a wall's (ContactSetup::wallTable).
+    CollisionLaw lawFor(int matA, int matB, bool wall, bool elastic) const;
     /// Throws std::invalid_argument unless World particle i's material is in the contact table.
     void requireKnownMaterial(std::size_t i) const;
     /// Whether the collisions of a material pair have beta = -1 whatever the velocities (Walton's rule with

@@ -50,6 +50,27 @@ std::string tdmReferences(const Scenario& sc, IntegratorKind integrator, bool po
     return r + ", F.3 time step";
 }
 
+/// The restitution the soft law really gives (contact-ending rule included; the event-driven engine's e): each
+/// material's pair of two mean particles, then each material of particles against each material of walls (their
+/// own calibration, docs/physics.md B.3). `what` names it as the method's lines always have.
+template <int D>
+void describeRestitution(const Scenario& sc, const World<D>& world, const char* what, std::ostream& out) {
+    const std::size_t nm = sc.materials.size();
+    for (std::size_t a = 0; a < nm; ++a)
+        out << fmt::format("material   {}: {} {:.5f} (incl. contact-end rule)\n", sc.materials[a].name, what,
+                           world.contact.pair(int(a), int(a)).restitution);
+    std::vector<bool> particles(nm, false), walls(nm, false);
+    for (std::uint16_t m : world.particles.material) particles[m] = true;
+    for (const InletDef& in : sc.inlets) particles[std::size_t(in.particles.material)] = true;
+    for (const WallDef& w : sc.walls) walls[std::size_t(w.material)] = true;
+    for (std::size_t a = 0; a < nm; ++a)
+        for (std::size_t b = 0; b < nm; ++b)
+            if (particles[a] && walls[b])
+                out << fmt::format("material   {} on walls of {}: {} {:.5f} (a particle against a wall, m_eff = m)\n",
+                                   sc.materials[a].name, sc.materials[b].name, what,
+                                   world.contact.wallPair(int(a), int(b)).restitution);
+}
+
 template <int D>
 void describeTdm(const Scenario& sc, std::ostream& out) {
     World<D> world = buildWorld<D>(sc);
@@ -88,9 +109,7 @@ void describeTdm(const Scenario& sc, std::ostream& out) {
     out << fmt::format("neighbours skin {:.4g} m, {} pairs in the initial list\n", ts.skin, pairs);
     out << fmt::format("memory     about {:.1f} MB ({} bytes per particle)\n",
                        (n * perParticle + pairs * perPair) / 1e6, n ? (n * perParticle + pairs * perPair) / n : 0);
-    for (std::size_t a = 0; a < sc.materials.size(); ++a)
-        out << fmt::format("material   {}: restitution of the soft law {:.5f} (incl. contact-end rule)\n",
-                           sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+    describeRestitution(sc, world, "restitution of the soft law", out);
     out << fmt::format("physics    docs/physics.md {}\n",
                        tdmReferences(sc, ts.integrator, world.particles.hasPolygons()));
 }
@@ -106,9 +125,7 @@ void describeEdm(const Scenario& sc, std::ostream& out) {
                        world.walls.size() + world.surfaces.size());
     describeWalls(world, out);
     out << fmt::format("collapse   TC model {} (tc_time = {:.4g} s)\n", sc.edm.tcModel ? "on" : "off", tc);
-    for (std::size_t a = 0; a < sc.materials.size(); ++a)
-        out << fmt::format("material   {}: restitution {:.5f} (the soft law's, incl. contact-end rule)\n",
-                           sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+    describeRestitution(sc, world, "restitution (the soft law's)", out);
     out << fmt::format(
         "physics    docs/physics.md C.1-C.2 collision rule, D.2-D.4 event times, D.6 invalid states{}{}\n",
         sc.edm.tcModel ? ", D.7 TC model" : "", world.surfaces.empty() ? "" : ", D.8 mesh walls");
@@ -143,10 +160,7 @@ void describeHaet(const Scenario& sc, std::ostream& out) {
     out << fmt::format(
         "collapse   modified EDM: dt_min = {:.4g} s (a collision sooner hands both particles to the TDM)\n",
         eng.dtMin());
-    for (std::size_t a = 0; a < sc.materials.size(); ++a)
-        out << fmt::format(
-            "material   {}: restitution {:.5f} in both engines (the soft law's, incl. contact-end rule)\n",
-            sc.materials[a].name, world.contact.pair(int(a), int(a)).restitution);
+    describeRestitution(sc, world, "restitution in both engines (the soft law's)", out);
     out << fmt::format(
         "physics    docs/physics.md A.1 one physics, A.2 zones, A.4 modified EDM; {}; C.1-C.2 collision rule, "
         "D.2-D.4 event times{}\n",

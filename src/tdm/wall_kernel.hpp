@@ -31,7 +31,7 @@ public:
           radius_(ctx.p.radius.data()),
           mass_(ctx.p.mass.data()),
           material_(ctx.p.material.data()),
-          table_(ctx.cs.table.data()),
+          table_(ctx.cs.wallTable.data()),
           nMaterials_(ctx.cs.nMaterials),
           dt_(ctx.dt),
           clip_(!ctx.cs.attraction),
@@ -84,7 +84,7 @@ private:
     const double* radius_;
     const double* mass_;
     const std::uint16_t* material_;
-    const PairCoeffs* table_;
+    const PairCoeffs* table_;  ///< ContactSetup::wallTable: particle material x wall material
     int nMaterials_;
     double dt_;
     bool clip_;

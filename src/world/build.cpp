@@ -80,30 +80,52 @@ static std::vector<bool> usedMaterials(const Scenario& sc, const std::vector<Mat
 }
 
 /// A reference head-on collision that does not end, or overlaps by more than the effective radius, means a contact
-/// law the scene's speeds break (Hertz with a tiny Young's modulus at impact_velocity): bad input, named.
+/// law the scene's speeds break (Hertz with a tiny Young's modulus at impact_velocity): bad input, named. So is a
+/// restitution the damped Hertz law cannot give under the contact-ending rule.
 static void checkHeadOn(const Scenario& sc, const ContactSetup& cs) {
     const ContactSetup::WorstHeadOn& w = cs.worstHeadOn;
-    if (w.a < 0 || w.overlapRatio <= 1) return;
     const bool hertz = sc.contact.normal == NormalLaw::Hertz;
-    if (!hertz && std::isfinite(w.overlapRatio)) return;  // the linear law's t_c is the user's; its e still holds
-    const MaterialDef& m = sc.materials[w.a];
+    auto contactOf = [&](int a, int b, bool wall) {
+        return "a head-on collision of " + sc.materials[a].name + " with " + (wall ? "a wall of " : "") +
+               sc.materials[b].name;
+    };
+    if (w.a >= 0 && w.overlapRatio > 1 && (hertz || !std::isfinite(w.overlapRatio))) {
+        // (the linear law's t_c is the user's; its e still holds)
+        const MaterialDef& m = sc.materials[w.a];
+        std::ostringstream os;
+        os << contactOf(w.a, w.b, w.wall) << " at impact_velocity " << sc.contact.impactVelocity << " m/s ";
+        if (std::isfinite(w.overlapRatio))
+            os << "overlaps by " << w.overlapRatio << " effective radii: the modulus is too small for contacts at "
+               << "this speed (Hertz needs overlaps well below the radius, docs/physics.md B.3)";
+        else
+            os << "does not end or is not finite: the contact law cannot be calibrated (docs/physics.md B.3)";
+        throw ScenarioError(hertz ? m.pos : sc.contact.pos,
+                            hertz ? "materials." + m.name + ".young" : std::string("contact"), os.str());
+    }
+    const ContactSetup::CalibrationMiss& miss = cs.calibrationMiss;
+    if (miss.a < 0) return;
+    // Blame the material whose restitution is the lower (the one that asks for the most damping).
+    const int m = sc.materials[miss.b].restitution < sc.materials[miss.a].restitution ? miss.b : miss.a;
     std::ostringstream os;
-    os << "a head-on collision of " << m.name << " with " << sc.materials[w.b].name << " at impact_velocity "
-       << sc.contact.impactVelocity << " m/s ";
-    if (std::isfinite(w.overlapRatio))
-        os << "overlaps by " << w.overlapRatio << " effective radii: the modulus is too small for contacts at this "
-           << "speed (Hertz needs overlaps well below the radius, docs/physics.md B.3)";
+    os << "the " << (sc.contact.hertzDamping == HertzDamping::Tsuji ? "Tsuji" : "viscoelastic")
+       << " Hertz law cannot give " << contactOf(miss.a, miss.b, miss.wall) << " the restitution " << miss.asked
+       << " (sqrt(e_a e_b)) at impact_velocity " << sc.contact.impactVelocity
+       << " m/s with attraction = " << (sc.contact.attraction ? "true" : "false") << ": ";
+    if (std::isnan(miss.obtained))
+        os << "the damping that would give it holds the bodies together";
     else
-        os << "does not end or is not finite: the contact law cannot be calibrated (docs/physics.md B.3)";
-    throw ScenarioError(hertz ? m.pos : sc.contact.pos,
-                        hertz ? "materials." + m.name + ".young" : std::string("contact"), os.str());
+        os << "the closest it comes is " << miss.obtained;
+    os << " (docs/physics.md B.3)";
+    throw ScenarioError(sc.materials[m].pos, "materials." + sc.materials[m].name + ".restitution", os.str());
 }
 
 template <int D>
 ContactSetup buildContactSetup(const Scenario& sc, const std::vector<MaterialStats>& stats) {
     const std::vector<MaterialProps> props(sc.materials.begin(), sc.materials.end());
-    ContactSetup cs =
-        buildContactSetup<D>(static_cast<const ContactModelDef&>(sc.contact), props, stats, usedMaterials(sc, stats));
+    std::vector<bool> walls(sc.materials.size(), false);
+    for (const WallDef& w : sc.walls) walls[w.material] = true;
+    ContactSetup cs = buildContactSetup<D>(static_cast<const ContactModelDef&>(sc.contact), props, stats,
+                                           usedMaterials(sc, stats), walls);
     checkHeadOn(sc, cs);
     return cs;
 }
