@@ -2,10 +2,11 @@
 BUILD ?= build
 JOBS ?= $(shell nproc)
 DEB_PACKAGES = cmake g++ make pkg-config libgtest-dev libbenchmark-dev libtomlplusplus-dev libcli11-dev \
-               libfmt-dev libcairo2-dev libpng-dev nlohmann-json3-dev zlib1g-dev clang-format python3 python3-matplotlib
+               libfmt-dev libcairo2-dev libpng-dev nlohmann-json3-dev zlib1g-dev clang-format python3 \
+               pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build test validate demo bench clean
+.PHONY: all deps build python test validate demo bench clean
 
 all: build
 
@@ -17,6 +18,11 @@ deps:
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
 	cmake --build $(BUILD) -j $(JOBS)
+
+# The Python module haet, for Debian's /usr/bin/python3 (docs/python.md): BUILD/python/haet*.so.
+python: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
+	cmake --build $(BUILD) -j $(JOBS) --target python
 
 test: build
 	cd $(BUILD) && ctest -L fast --output-on-failure -j $(JOBS)

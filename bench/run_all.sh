@@ -14,6 +14,8 @@
 # 8. BUILD_DIR/haet_bench                   Google Benchmark micro-benchmarks, when built
 # 9. BUILD_DIR/haet_bench PolygonSettle2D   10 000 hexagons vs 10 000 disks settling, 1 and 2 threads, side by
 #                                           side in one run, with the polygon/disk cost ratio
+# 10. bench/python_step_loop.py             a Python loop of 10 000 sim.step(1) against sim.step(10000), 10 000
+#                                           disks (when the module is built: BUILD_DIR/python)
 # The first run on a machine prepares the flowing states with LAMMPS (10-15 min for 3D, once; kept in
 # bench/data/) and LIGGGHTS (a few minutes), and the settled bed (about a minute). Installs the Debian packages
 # lammps, liggghts and time when missing. Exits non-zero when any part failed, after running the others.
@@ -85,6 +87,14 @@ if [ -x "$build/haet_bench" ]; then
     rm -f "$csv"
 else
     echo "=== micro-benchmarks: $build/haet_bench not built (needs libbenchmark-dev and bench/*.cpp); skipped"
+fi
+
+if ls "$build"/python/haet*.so >/dev/null 2>&1; then
+    echo "=== Python: a loop of single steps against one call (bench/python_step_loop.py)"
+    PYTHONPATH="$build/python" /usr/bin/python3 "$here/python_step_loop.py" || failed="$failed python_step_loop"
+    echo
+else
+    echo "=== Python: $build/python not built (make python); skipped"
 fi
 
 if [ -n "$failed" ]; then

@@ -19,8 +19,9 @@ namespace fs = std::filesystem;
 int layerOf(const std::string& path) {
     if (path == "world/world.hpp") return 3;
     static const std::map<std::string, int> kLayers = {
-        {"core", 0},    {"io", 1},   {"geometry", 1}, {"contact", 2},  {"neighbor", 3}, {"tdm", 4},  {"edm", 4},
-        {"polygon", 5}, {"haet", 6}, {"measure", 7},  {"scenario", 8}, {"world", 9},    {"run", 10}, {"app", 11},
+        {"core", 0},     {"io", 1},    {"geometry", 1}, {"contact", 2}, {"neighbor", 3},
+        {"tdm", 4},      {"edm", 4},   {"polygon", 5},  {"haet", 6},    {"measure", 7},
+        {"scenario", 8}, {"world", 9}, {"run", 10},     {"app", 11},    {"python", 11},
     };
     const auto it = kLayers.find(path.substr(0, path.find('/')));
     return it == kLayers.end() ? -1 : it->second;

@@ -78,6 +78,12 @@ void EdmEngine<D>::requireKnownMaterial(std::size_t i) const {
 }
 
 template <int D>
+void EdmEngine<D>::restart() {
+    sl_.g = w_.domain.gravity;
+    reset();
+}
+
+template <int D>
 void EdmEngine<D>::reset() {
     Particles<D>& p = w_.particles;
     if (!p.hasMotion())

@@ -169,6 +169,8 @@ public:
     /// frozen flags, particles added or removed) and re-predicts all events. The engine keeps its own copy of
     /// positions and velocities, so outside changes are lost at the next advanceTo without it.
     void reset();
+    /// reset(), after gravity too may have changed (Domain::gravity, which the predictions of free flight use).
+    void restart();
 
     std::uint64_t events() const { return events_; }  ///< events processed (collisions, crossings, stale)
     std::uint64_t collisions() const { return stats_.pairCollisions + stats_.wallCollisions; }

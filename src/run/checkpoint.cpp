@@ -153,6 +153,43 @@ void checkStateKeys(const std::string& saved, const Scenario& sc) {
     differ("the order of its tables", "", "");  // same lines, another text: cannot happen for the loader's text
 }
 
+namespace {
+
+/// A checkpoint file read and parsed (CheckpointError when it cannot be read or is not whole).
+ResumePoint parsedCheckpoint(const std::filesystem::path& file) {
+    ResumePoint r;
+    r.path = file;
+    r.bytes = readWhole(file);
+    r.file = parseCheckpoint(r.bytes);
+    return r;
+}
+
+void checkScenarioOf(const ResumePoint& r, const Scenario& sc) {
+    try {
+        ByteReader keys = r.file.section("SCEN");
+        checkStateKeys(keys.getString(), sc);
+        if (r.file.header.scenarioHash != sc.stateHash)
+            throw CheckpointError(CheckpointFault::OtherScenario, "the checkpoint is of another scenario (hash " +
+                                                                      r.file.header.scenarioHash + ", this one's " +
+                                                                      sc.stateHash + ")");
+    } catch (const CheckpointError& e) {
+        throw CheckpointError(e.fault(), r.path.string() + ": " + e.what());
+    }
+}
+
+}  // namespace
+
+ResumePoint readCheckpoint(const std::filesystem::path& file, const Scenario& sc) {
+    ResumePoint r;
+    try {
+        r = parsedCheckpoint(file);
+    } catch (const CheckpointError& e) {
+        throw CheckpointError(e.fault(), file.string() + ": " + e.what());
+    }
+    checkScenarioOf(r, sc);
+    return r;
+}
+
 ResumePoint findCheckpoint(const std::filesystem::path& dir, const Scenario& sc, std::ostream& log) {
     const std::vector<std::filesystem::path> all = listCheckpoints(dir);
     if (all.empty())
@@ -161,10 +198,8 @@ ResumePoint findCheckpoint(const std::filesystem::path& dir, const Scenario& sc,
     std::string why;
     for (const std::filesystem::path& p : all) {
         ResumePoint r;
-        r.path = p;
         try {
-            r.bytes = readWhole(p);
-            r.file = parseCheckpoint(r.bytes);
+            r = parsedCheckpoint(p);
         } catch (const CheckpointError& e) {
             if (e.fault() == CheckpointFault::FutureVersion)
                 throw CheckpointError(e.fault(), p.string() + ": " + e.what());
@@ -173,16 +208,7 @@ ResumePoint findCheckpoint(const std::filesystem::path& dir, const Scenario& sc,
             why += "\n  " + p.string() + ": " + e.what();
             continue;
         }
-        try {
-            ByteReader keys = r.file.section("SCEN");
-            checkStateKeys(keys.getString(), sc);
-            if (r.file.header.scenarioHash != sc.stateHash)
-                throw CheckpointError(CheckpointFault::OtherScenario, "the checkpoint is of another scenario (hash " +
-                                                                          r.file.header.scenarioHash + ", this one's " +
-                                                                          sc.stateHash + ")");
-        } catch (const CheckpointError& e) {
-            throw CheckpointError(e.fault(), p.string() + ": " + e.what());
-        }
+        checkScenarioOf(r, sc);
         return r;
     }
     throw CheckpointError(CheckpointFault::Corrupt, dir.string() + ": no whole checkpoint to resume from:" + why);

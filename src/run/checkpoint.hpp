@@ -38,6 +38,10 @@ struct ResumePoint {
 /// to change (OtherScenario, naming the key); ScenarioError-like std::invalid_argument when dir has no checkpoint.
 ResumePoint findCheckpoint(const std::filesystem::path& dir, const Scenario& sc, std::ostream& log);
 
+/// One checkpoint file, to start a run of `sc` from: throws CheckpointError (naming the file) when it is not whole,
+/// cannot be read, of a later format or of another scenario.
+ResumePoint readCheckpoint(const std::filesystem::path& file, const Scenario& sc);
+
 /// Throws CheckpointError (OtherScenario) naming the first key in which `saved` ("key = value" lines, as
 /// Scenario::stateKeys) and the scenario differ.
 void checkStateKeys(const std::string& saved, const Scenario& sc);

@@ -14,6 +14,10 @@ namespace haet {
 /// The progress line on stderr: Auto shows it on a terminal unless quiet. It never changes what is computed.
 enum class ProgressDisplay { Auto, On, Off };
 
+/// When a run catches SIGINT and SIGTERM to stop cleanly: for its whole life (`haet run`), only while advance() runs
+/// (a script's run: Ctrl-C between its calls is the script's), or never (a run advanced off the main thread).
+enum class StopScope { Run, Advance, Never };
+
 struct RunOptions {
     std::filesystem::path outDir;  ///< empty: the scenario's [output] directory
     int threads = 0;               ///< 0: OpenMP default
@@ -22,6 +26,11 @@ struct RunOptions {
     /// Non-empty: go on from the newest whole checkpoint of this run directory (which is also the output
     /// directory), instead of starting at t = 0 (docs/scenario.md, "Resuming").
     std::filesystem::path resumeDir;
+    /// When the SIGINT / SIGTERM handlers (run/stop.hpp) are installed.
+    StopScope stopSignals = StopScope::Run;
+    /// Non-empty: start from this checkpoint file (the state of a run saved by a script) with new outputs in the
+    /// output directory, instead of from the scenario's initial state. The series starts at the checkpoint's time.
+    std::filesystem::path startFrom;
 };
 
 /// The exit code of `haet run` for each outcome.

@@ -47,11 +47,14 @@ template <int D>
 class Session final : public RunSession {
 public:
     Session(const Scenario& sc, const RunOptions& opt, std::ostream& log)
-        : sc_(sc), opt_(opt), log_(log), t0_(Clock::now()), dir_(runDirectory(sc_, opt_)) {
-        // A resumed run starts from the newest whole checkpoint of its directory: the World built from the
-        // scenario (box, walls, contact table) takes the saved particles, the engine is made on them and takes its
-        // own state.
+        : sc_(sc), opt_(opt), log_(log), t0_(Clock::now()), dir_(runDirectory(sc_, opt_)), scope_(opt.stopSignals) {
+        if (scope_ == StopScope::Run) signals_.emplace();
+        // A resumed run starts from the newest whole checkpoint of its directory (or a script's from a saved file):
+        // the World built from the scenario (box, walls, contact table) takes the saved particles, the engine is
+        // made on them and takes its own state.
         if (!opt_.resumeDir.empty()) resume_ = findCheckpoint(dir_, sc_, log_);
+        const bool startFrom = !opt_.startFrom.empty() && opt_.resumeDir.empty();
+        if (startFrom) resume_ = readCheckpoint(opt_.startFrom, sc_);
         world_.emplace(buildWorld<D>(sc_));
         World<D>& world = *world_;
         if (resume_) {
@@ -59,7 +62,7 @@ public:
             loadWorld(in, world);
             in.expectEnd();
         }
-        eng_ = makeDriver<D>(sc_, world, signals_.flag());
+        eng_ = makeDriver<D>(sc_, world, StopSignals::flag());
         if (resume_) {
             if (!eng_->restartable())
                 throw std::invalid_argument(std::string("--resume: runs of method \"") + eng_->method() +
@@ -69,7 +72,7 @@ public:
         plan_ = planRun(sc_, eng_->dt(), world.contact.contactTime);
         for (const auto& [key, what] : plan_.warnings) log_ << "warning: " << key << ": " << what << "\n";
 
-        if (!resume_) prepareRunDirectory(dir_);
+        if (!resume_ || startFrom) prepareRunDirectory(dir_);
         std::vector<std::string> columns = {
             "time",         "step",        "kinetic_energy", "rotational_energy", "potential_energy", "elastic_energy",
             "total_energy", "n_particles", "n_contacts",     "max_overlap_ratio", "pressure"};
@@ -86,7 +89,8 @@ public:
         eng_->setCollisionHook([this](const EdmCollision<D>& c) { measures_->collision(c); });
         lastRowTime_ = world.time;
         // A resumed run's series.csv as the stopped run left it, read before it is rewritten.
-        std::string savedSeries = resume_ ? readFileText(dir_ / "series.csv") : std::string();
+        const bool resumeDir = resume_ && !startFrom;
+        std::string savedSeries = resumeDir ? readFileText(dir_ / "series.csv") : std::string();
         // A run killed before its end (kill -9, a node lost) leaves run.json saying so; it also proves the
         // directory writable before any time is spent.
         writeRunJson("running");
@@ -104,7 +108,11 @@ public:
         // engine's state depends on where its calls end): up to every output time and every 1/500 of the run, at
         // which the progress line may update (at most every 200 ms).
         chunks_ = OutputClock(sc_.duration / 500);
-        if (resume_) {
+        if (startFrom) {  // new outputs from the saved time on; the state saved is not written again
+            ckpts_.pass(world.time, eps_);
+            lastCheckpoint_ = world.time;
+        }
+        if (resumeDir) {
             // The outputs as they were when the checkpoint was written: series.csv up to its rows (a stopped run's
             // last-state row after it is not the schedule's), the collections' entries; the clocks from the times
             // of the last outputs, so that periods changed on resume take effect from here.
@@ -136,6 +144,22 @@ public:
     bool advance(double until) override {
         if (stopped_ || finished_) return false;
         World<D>& world = *world_;
+        // A script's run catches the signals only while it advances; a piece after an interrupted one goes on.
+        std::optional<StopSignals> during;
+        if (scope_ != StopScope::Run) {
+            StopSignals::clear();
+            if (scope_ == StopScope::Advance && !StopSignals::installed()) {
+                try {
+                    during.emplace();
+                } catch (const std::logic_error&) {  // another thread's run installed them meanwhile
+                }
+            }
+            if (status_ == RunStatus::Interrupted || status_ == RunStatus::Terminated) {
+                status_ = RunStatus::Completed;
+                statusText_ = "completed";
+                stopSignal_ = 0;
+            }
+        }
         try {
             for (;;) {
                 if (rows_.due(world.time, eps_)) {
@@ -154,7 +178,7 @@ public:
                     if (lastCheckpoint_ != world.time) checkpoint();
                     ckpts_.pass(world.time, eps_);
                 }
-                if (world.time + eps_ >= until || signals_.requested()) break;
+                if (world.time + eps_ >= until || StopSignals::requested()) break;
                 // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
                 const double target = std::min(
                     {until, rows_.next(), shots_.next(), ckpts_.next(), flow_->nextTime(), measures_->nextTime()});
@@ -184,20 +208,19 @@ public:
             }
             throw;
         }
-        if (signals_.requested()) stopped_ = true;
-        return !stopped_;
+        if (!StopSignals::requested()) return !stopped_;
+        noteStop();
+        return false;
     }
 
     RunStatus finish() override {
         if (finished_) return status_;
         finished_ = true;
         World<D>& world = *world_;
-        if (signals_.requested() && status_ != RunStatus::BlewUp) {
-            status_ = signals_.signal() == SIGINT ? RunStatus::Interrupted : RunStatus::Terminated;
-            statusText_ = "interrupted";
-            log_ << (signals_.signal() == SIGINT ? "\nSIGINT" : "\nSIGTERM") << ": stopped at t = " << world.time
+        if (scope_ == StopScope::Run && StopSignals::requested()) noteStop();
+        if (stopSignal_ != 0 && status_ != RunStatus::BlewUp)
+            log_ << (stopSignal_ == SIGINT ? "\nSIGINT" : "\nSIGTERM") << ": stopped at t = " << world.time
                  << " s; writing the last state\n";
-        }
         // The last state, always: a checkpoint (before the last row and snapshot, which are not the schedule's: a
         // resumed run drops them), then a row and a snapshot at the time the run ended, unless the schedule just
         // wrote them. A blown-up state is not checkpointed: the last checkpoint stays the newest.
@@ -229,8 +252,28 @@ public:
     double time() const override { return world_->time; }
     std::uint64_t steps() const override { return eng_->steps(); }
     RunStatus status() const override { return status_; }
+    std::string statusText() const override { return statusText_; }
     const Scenario& scenario() const override { return sc_; }
     void synchronise() override { eng_->synchronise(); }
+    double dt() const override { return eng_->dt(); }
+    const char* method() const override { return eng_->method(); }
+    const std::filesystem::path& directory() const override { return dir_; }
+    void flush() override { series_->flush(); }
+    void setStopScope(StopScope scope) override {
+        if (scope_ == StopScope::Run || scope == StopScope::Run)
+            throw std::logic_error("RunSession: the signals of `haet run` are caught for its whole life");
+        scope_ = scope;
+    }
+    void stateChanged() override { eng_->stateChanged(); }
+    void added(std::size_t first) override { eng_->added(first); }
+    void remove(const std::vector<std::uint32_t>& which) override { eng_->remove(which); }
+    void save(const std::filesystem::path& file) override {
+        if (!checkpoints_)
+            throw std::invalid_argument(std::string("runs of method \"") + eng_->method() +
+                                        "\" cannot be checkpointed yet");
+        writeFileAtomic(file, checkpointBytes(sequence_ + 1));
+        eng_->synchronise();
+    }
 
 protected:
     World<2>* world2() override {
@@ -286,12 +329,31 @@ private:
         lastShot_ = world_->time;
     }
 
+    /// The first signal that stopped the run: the outcome it gives.
+    void noteStop() {
+        if (status_ == RunStatus::BlewUp) return;
+        stopSignal_ = StopSignals::signal();
+        status_ = stopSignal_ == SIGINT ? RunStatus::Interrupted : RunStatus::Terminated;
+        statusText_ = "interrupted";
+        if (scope_ == StopScope::Run) stopped_ = true;
+    }
+
     /// A checkpoint: the whole state at world.time and the outputs written so far (series.csv flushed first, so
     /// that the file on disk always holds at least the rows a checkpoint counts).
     void checkpoint() {
         if (!checkpoints_) return;
-        const World<D>& world = *world_;
         const auto start = Clock::now();
+        const std::string file = checkpointBytes(++sequence_);
+        writeCheckpoint(dir_, sequence_, file);
+        lastCheckpoint_ = world_->time;
+        ckptBook_.written += 1;
+        ckptBook_.bytes = file.size();
+        ckptBook_.seconds += std::chrono::duration<double>(Clock::now() - start).count();
+    }
+
+    /// The bytes of checkpoint number `sequence` of the state now.
+    std::string checkpointBytes(std::uint64_t sequence) {
+        const World<D>& world = *world_;
         eng_->exposeState();
         series_->flush();
         ByteWriter body;
@@ -311,7 +373,7 @@ private:
         measures_->saveState(body);
         body.endSection();
         body.beginSection("RUN ");
-        body.put<std::uint64_t>(sequence_ + 1);
+        body.put<std::uint64_t>(sequence);
         body.put<double>(lastRow_);
         body.put<double>(lastShot_);
         body.put<double>(lastRowTime_);
@@ -323,13 +385,8 @@ private:
         h.method = eng_->method();
         h.scenarioHash = sc_.stateHash;
         h.time = world.time;
-        h.sequence = ++sequence_;
-        const std::string file = encodeCheckpoint(h, body.bytes());
-        writeCheckpoint(dir_, sequence_, file);
-        lastCheckpoint_ = world.time;
-        ckptBook_.written += 1;
-        ckptBook_.bytes = file.size();
-        ckptBook_.seconds += std::chrono::duration<double>(Clock::now() - start).count();
+        h.sequence = sequence;
+        return encodeCheckpoint(h, body.bytes());
     }
 
     void writeRunJson(const std::string& status) {
@@ -399,8 +456,10 @@ private:
     const Clock::time_point t0_;
     const std::filesystem::path dir_;
     std::optional<ResumePoint> resume_;
+    StopScope scope_;
     std::optional<World<D>> world_;
-    StopSignals signals_;
+    std::optional<StopSignals> signals_;  // StopScope::Run: for the session's life
+    int stopSignal_ = 0;                  // the signal that stopped it (0: none)
     std::unique_ptr<Driver<D>> eng_;
     RunPlan plan_;
     std::optional<Flow<D>> flow_;

@@ -43,8 +43,14 @@ StopSignals::~StopSignals() {
     gInstalled = false;
 }
 
-const std::atomic<bool>* StopSignals::flag() const { return &gStop; }
-bool StopSignals::requested() const { return gStop.load(std::memory_order_relaxed); }
-int StopSignals::signal() const { return gSignal.load(); }
+const std::atomic<bool>* StopSignals::flag() { return &gStop; }
+bool StopSignals::requested() { return gStop.load(std::memory_order_relaxed); }
+int StopSignals::signal() { return gSignal.load(); }
+bool StopSignals::installed() { return gInstalled.load(); }
+void StopSignals::clear() {
+    if (gInstalled.load()) return;
+    gStop = false;
+    gSignal = 0;
+}
 
 }  // namespace haet

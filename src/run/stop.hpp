@@ -15,11 +15,16 @@ public:
     StopSignals(const StopSignals&) = delete;
     StopSignals& operator=(const StopSignals&) = delete;
 
-    /// The flag the engines poll (set by the first signal).
-    const std::atomic<bool>* flag() const;
-    bool requested() const;
+    /// The flag the engines poll (set by the first signal). The same flag whether or not handlers are installed,
+    /// so that an engine made before them (a script's run installs them only while it advances) sees them.
+    static const std::atomic<bool>* flag();
+    static bool requested();
     /// The signal that asked for the stop (SIGINT, SIGTERM), 0 before one came.
-    int signal() const;
+    static int signal();
+    /// Whether an instance exists now.
+    static bool installed();
+    /// Clears the flag and the signal, when no instance is installed (a new piece of a script's run, after a stop).
+    static void clear();
 };
 
 }  // namespace haet

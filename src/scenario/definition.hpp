@@ -42,9 +42,10 @@ struct SourcePos {
 class ScenarioError : public std::runtime_error {
 public:
     ScenarioError(const SourcePos& pos, const std::string& key, const std::string& what)
-        : std::runtime_error(format(pos, key, what)), pos_(pos), key_(key) {}
+        : std::runtime_error(format(pos, key, what)), pos_(pos), key_(key), message_(what) {}
     const SourcePos& pos() const { return pos_; }
     const std::string& key() const { return key_; }
+    const std::string& message() const { return message_; }  ///< what is wrong, without the place and key
 
 private:
     static std::string format(const SourcePos& p, const std::string& key, const std::string& what) {
@@ -56,6 +57,7 @@ private:
     }
     SourcePos pos_;
     std::string key_;
+    std::string message_;
 };
 
 struct DomainDef {

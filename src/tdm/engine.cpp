@@ -261,6 +261,17 @@ void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
 }
 
 template <int D>
+void TdmEngine<D>::restart() {
+    // The constructor's sequence, without its sort (the particles keep their places) and its walls' move (the
+    // walls are at the current time already).
+    rebuild(false);
+    motion_.v = w_.particles.v;
+    motion_.w = w_.particles.w;
+    computeForces(false);
+    integ_->start(w_.particles, s_.dt);
+}
+
+template <int D>
 void TdmEngine<D>::contactCounts(std::vector<std::uint8_t>& out) const {
     const Particles<D>& p = w_.particles;
     const std::size_t n = p.tdmCount();

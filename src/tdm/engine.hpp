@@ -58,6 +58,10 @@ public:
     /// Call at a step boundary.
     static constexpr std::uint32_t kFresh = 0xFFFFFFFFu;
     void remap(const std::vector<std::uint32_t>& from);
+    /// After outside changes of the particles in place at a step boundary (positions, velocities, spins, radii,
+    /// masses, frozen flags) or of gravity: the pair list, the step's velocities, the forces and the integrator's
+    /// start as a new engine's on this state would be; the contacts' springs are kept (remap keeps them too).
+    void restart();
     /// out[i]: contacts of particle i at the current positions, a wall contact counting 2 (resting on a wall
     /// weighs like two neighbours); saturates at 255. For i < tdmCount().
     void contactCounts(std::vector<std::uint8_t>& out) const;
