@@ -3,7 +3,9 @@
 // kind of scene, on one and two threads; a checkpoint that is truncated, corrupt, of a later format or of another
 // scenario is refused with exit code 2 and a message that says which, and a corrupt newest one gives way to the one
 // before it. The runs are of the `haet` program, on scenes of examples/ shortened by overrides.
+#include <cmath>
 #include <csignal>
+#include <limits>
 #include <regex>
 #include <string>
 #include <thread>
@@ -12,6 +14,9 @@
 #include "cli_util.hpp"
 #include "io/checkpoint.hpp"
 #include "run/checkpoint.hpp"
+#include "scenario/loader.hpp"
+#include "world/build.hpp"
+#include "world/state.hpp"
 
 namespace {
 
@@ -244,6 +249,34 @@ TEST_F(RestartFaults, ReaderRefusesEveryPrefixAndEveryFlippedByte) {
         b[at] = static_cast<char>(b[at] ^ 0x10);
         EXPECT_THROW(haet::parseCheckpoint(b), haet::CheckpointError) << "byte " << at;
     }
+}
+
+// A state that no run saves (a run stops at the first NaN), in a file whose checksum is right: a NaN or infinite
+// position, velocity or spin is refused by the World's loader, before an engine bins the position into a cell.
+TEST(RestartState, NonFiniteParticlesAreRefused) {
+    const haet::Scenario sc = haet::loadScenario(std::string(HAET_SOURCE_DIR) + "/examples/drop3d_tiny.toml");
+    const haet::World<3> built = haet::buildWorld<3>(sc);
+    for (int which = 0; which < 4; ++which) {
+        haet::World<3> w = built;
+        const double bad = which == 3 ? -std::numeric_limits<double>::infinity() : std::nan("");
+        (which == 1 ? w.particles.v : which == 2 ? w.particles.w : w.particles.x)[3][1] = bad;
+        haet::ByteWriter out;
+        haet::saveWorld(out, w);
+        haet::ByteReader in(out.bytes(), "WRLD");
+        haet::World<3> back = built;
+        try {
+            haet::loadWorld(in, back);
+            ADD_FAILURE() << "case " << which << " was taken";
+        } catch (const haet::CheckpointError& e) {
+            EXPECT_EQ(e.fault(), haet::CheckpointFault::Corrupt);
+            EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
+        }
+    }
+    haet::ByteWriter out;
+    haet::saveWorld(out, built);
+    haet::ByteReader in(out.bytes(), "WRLD");
+    haet::World<3> back = built;
+    EXPECT_NO_THROW(haet::loadWorld(in, back));
 }
 
 // A run stopped by SIGINT or SIGTERM (the batch system's time limit) at whatever step it was in: exit 130 / 143,

@@ -5,6 +5,18 @@
 
 namespace haet {
 
+namespace {
+
+template <int N>
+bool allFinite(const std::vector<Vec<N>>& values) {
+    for (const Vec<N>& a : values)
+        for (int k = 0; k < N; ++k)
+            if (!std::isfinite(a[k])) return false;
+    return true;
+}
+
+}  // namespace
+
 template <int D>
 void saveWorld(ByteWriter& out, const World<D>& w) {
     const Particles<D>& p = w.particles;
@@ -81,6 +93,9 @@ void loadWorld(ByteReader& in, World<D>& w) {
         if (int(m) >= w.contact.nMaterials) in.fail("a particle's material is not in the scenario");
     for (double r : q.radius)
         if (!(r > 0) || !std::isfinite(r)) in.fail("a radius is not a positive number");
+    // A run stops at the first non-finite state (exit code 3), so a saved one is finite; the engines' grids take a
+    // position's cell by a conversion to int that a NaN would make undefined.
+    if (!allFinite(q.x) || !allFinite(q.v) || !allFinite(q.w)) in.fail("a position, velocity or spin is not finite");
     q.nTdm = nTdm;
     p = std::move(q);
     w.time = time;
