@@ -252,7 +252,8 @@ TEST_F(RestartFaults, ReaderRefusesEveryPrefixAndEveryFlippedByte) {
 }
 
 // A state that no run saves (a run stops at the first NaN), in a file whose checksum is right: a NaN or infinite
-// position, velocity or spin is refused by the World's loader, before an engine bins the position into a cell.
+// position, velocity or spin, or a position beyond any cell index, is refused by the World's loader, before an
+// engine bins the position into a cell.
 TEST(RestartState, NonFiniteParticlesAreRefused) {
     const haet::Scenario sc = haet::loadScenario(std::string(HAET_SOURCE_DIR) + "/examples/drop3d_tiny.toml");
     const haet::World<3> built = haet::buildWorld<3>(sc);
@@ -272,11 +273,20 @@ TEST(RestartState, NonFiniteParticlesAreRefused) {
             EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
         }
     }
-    haet::ByteWriter out;
-    haet::saveWorld(out, built);
-    haet::ByteReader in(out.bytes(), "WRLD");
-    haet::World<3> back = built;
-    EXPECT_NO_THROW(haet::loadWorld(in, back));
+    // 1e294 m (a checkpoint the fuzzer made): beyond any cell index of the grids; 5 box lengths away is a state.
+    for (double x : {-2.46e294, 0.05}) {
+        haet::World<3> w = built;
+        w.particles.x[2][0] = x;
+        haet::ByteWriter out;
+        haet::saveWorld(out, w);
+        haet::ByteReader in(out.bytes(), "WRLD");
+        haet::World<3> back = built;
+        if (x < 0) {
+            EXPECT_THROW(haet::loadWorld(in, back), haet::CheckpointError);
+        } else {
+            EXPECT_NO_THROW(haet::loadWorld(in, back));
+        }
+    }
 }
 
 // A run stopped by SIGINT or SIGTERM (the batch system's time limit) at whatever step it was in: exit 130 / 143,
