@@ -39,7 +39,8 @@ inline SampleStats sampleStats(const std::vector<double>& v) {
 /// Whether two arrays hold the same bits (not only equal values: -0 and 0, NaNs told apart).
 template <class T>
 bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+    // Empty vectors may hold no storage at all: memcmp of a null pointer is undefined even for 0 bytes.
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 /// A measured value in the test's XML report (--gtest_output=xml), to follow margins over time.

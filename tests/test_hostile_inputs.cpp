@@ -219,4 +219,65 @@ TEST_F(Hostile, RestitutionOptionalWithKnAndGammaN) {
     expectRejected(noE, "materials.glass.restitution", "is required");
 }
 
+// A centre of 1e92 m in a file of hard particles in a periodic box: the overlap test binned it into a cell before the
+// centre was checked, an index far beyond any int (undefined behaviour, a wild cell). Now the file's line, first.
+TEST_F(Hostile, FarCentreFromAFileIsOutsideTheDomain) {
+    write("far.csv", "x,y,z,radius\n0.005,0.005,0.005,0.001\n1e92,0.005,0.005,0.001\n");
+    const std::string periodic =
+        haet::testing::replaced(edit("duration = 0.001", "duration = 0.001\nmethod = \"edm\""),
+                                "hi = [0.01, 0.01, 0.01]", "hi = [0.01, 0.01, 0.01]\nperiodic = [true, true, false]");
+    const Result r = check(withInsert("arrangement = \"file\"\nfile = \"far.csv\"\nmaterial = \"glass\"\n", periodic));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find((dir_ / "far.csv").string() + ":3: insert[1].file: particle centre lies outside the domain"),
+              std::string::npos)
+        << r.err;
+}
+
+// Particle files are text: a NUL byte (a binary file given by mistake) and a line of more than 1 MiB (which was read
+// whole into memory, without bound) are errors at the file's line; a device such as /dev/zero is not opened.
+TEST_F(Hostile, ParticleFilesAreText) {
+    const std::string insert = "arrangement = \"file\"\nfile = \"grains.csv\"\nmaterial = \"glass\"\n";
+    write("grains.csv", std::string("x,y,z,radius\n0.005,0.005,0.005,0.001\n0.002,0.0") + '\0' + "2,0.002,0.001\n");
+    Result r = check(withInsert(insert));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find((dir_ / "grains.csv").string() + ":3: insert[1].file: a NUL byte"), std::string::npos)
+        << r.err;
+    write("grains.csv", "x,y,z,radius\n" + std::string(std::size_t(3) << 19, ' ') + "0.005,0.005,0.005,0.001\n");
+    r = check(withInsert(insert));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find((dir_ / "grains.csv").string() + ":2: insert[1].file: line longer than 1 MiB"),
+              std::string::npos)
+        << r.err;
+    r = check(withInsert("arrangement = \"file\"\nfile = \"/dev/zero\"\nmaterial = \"glass\"\n"));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("insert[1].file: not a regular file (a directory or a device): /dev/zero"), std::string::npos)
+        << r.err;
+}
+
+// LAMMPS atom types and image flags beyond 32 bits were cut to an int without a word (type 4294967297 became
+// type 1): the line that holds them.
+TEST_F(Hostile, LammpsIntegersBeyond32Bits) {
+    const std::string insert =
+        "arrangement = \"file\"\nfile = \"bed.data\"\nformat = \"lammps\"\nmaterial = \"glass\"\n";
+    const std::string head =
+        "LAMMPS data file\n\n1 atoms\n\n0 0.01 xlo xhi\n0 0.01 ylo yhi\n0 0.01 zlo zhi\n\n"
+        "Atoms # sphere\n\n";
+    write("bed.data", head + "1 4294967297 0.002 2500 0.005 0.005 0.005\n");
+    Result r = check(withInsert(insert));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find((dir_ / "bed.data").string() + ":11: insert[1].file: Atoms line: atom type must be an "
+                                                        "integer from 1 to 2147483647, got \"4294967297\""),
+              std::string::npos)
+        << r.err;
+    write("bed.data", head + "1 1 0.002 2500 0.005 0.005 0.005 0 3000000000 0\n");
+    r = check(withInsert(insert));
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find((dir_ / "bed.data").string() + ":11: insert[1].file: Atoms line: image flag must be an "
+                                                        "integer within +-2^31, got \"3000000000\""),
+              std::string::npos)
+        << r.err;
+    write("bed.data", head + "1 1 0.002 2500 0.005 0.005 0.005 0 -2 0\n");
+    EXPECT_EQ(check(withInsert(insert)).code, 0);
+}
+
 }  // namespace

@@ -4,7 +4,9 @@
 // scenario is refused with exit code 2 and a message that says which, and a corrupt newest one gives way to the one
 // before it. The runs are of the `haet` program, on scenes of examples/ shortened by overrides.
 #include <algorithm>
+#include <cmath>
 #include <csignal>
+#include <limits>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -14,6 +16,9 @@
 #include "cli_util.hpp"
 #include "io/checkpoint.hpp"
 #include "run/checkpoint.hpp"
+#include "scenario/loader.hpp"
+#include "world/build.hpp"
+#include "world/state.hpp"
 
 namespace {
 
@@ -471,6 +476,44 @@ TEST_F(RestartFaults, ReaderRefusesEveryPrefixAndEveryFlippedByte) {
         std::string b = bytes;
         b[at] = static_cast<char>(b[at] ^ 0x10);
         EXPECT_THROW(haet::parseCheckpoint(b), haet::CheckpointError) << "byte " << at;
+    }
+}
+
+// A state that no run saves (a run stops at the first NaN), in a file whose checksum is right: a NaN or infinite
+// position, velocity or spin, or a position beyond any cell index, is refused by the World's loader, before an
+// engine bins the position into a cell.
+TEST(RestartState, NonFiniteParticlesAreRefused) {
+    const haet::Scenario sc = haet::loadScenario(std::string(HAET_SOURCE_DIR) + "/examples/drop3d_tiny.toml");
+    const haet::World<3> built = haet::buildWorld<3>(sc);
+    for (int which = 0; which < 4; ++which) {
+        haet::World<3> w = built;
+        const double bad = which == 3 ? -std::numeric_limits<double>::infinity() : std::nan("");
+        (which == 1 ? w.particles.v : which == 2 ? w.particles.w : w.particles.x)[3][1] = bad;
+        haet::ByteWriter out;
+        haet::saveWorld(out, w);
+        haet::ByteReader in(out.bytes(), "WRLD");
+        haet::World<3> back = built;
+        try {
+            haet::loadWorld(in, back);
+            ADD_FAILURE() << "case " << which << " was taken";
+        } catch (const haet::CheckpointError& e) {
+            EXPECT_EQ(e.fault(), haet::CheckpointFault::Corrupt);
+            EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
+        }
+    }
+    // 1e294 m (a checkpoint the fuzzer made): beyond any cell index of the grids; 5 box lengths away is a state.
+    for (double x : {-2.46e294, 0.05}) {
+        haet::World<3> w = built;
+        w.particles.x[2][0] = x;
+        haet::ByteWriter out;
+        haet::saveWorld(out, w);
+        haet::ByteReader in(out.bytes(), "WRLD");
+        haet::World<3> back = built;
+        if (x < 0) {
+            EXPECT_THROW(haet::loadWorld(in, back), haet::CheckpointError);
+        } else {
+            EXPECT_NO_THROW(haet::loadWorld(in, back));
+        }
     }
 }
 

@@ -8,13 +8,13 @@
 #include <immintrin.h>
 #endif
 
+#include "core/lane_shuffle.hpp"
 #include "core/vec.hpp"
 
 namespace haet {
 
 struct Wide3 {
     using Lanes = double __attribute__((vector_size(32)));
-    using Index = long long __attribute__((vector_size(32)));
     Lanes l;
 
     static Wide3 zero() { return {Lanes{0, 0, 0, 0}}; }
@@ -53,9 +53,8 @@ inline double dot(const Wide3& a, const Wide3& b) {
 inline double norm2(const Wide3& a) { return dot(a, a); }
 /// a x b, component for component as cross(Vec<3>, Vec<3>).
 inline Wide3 cross(const Wide3& a, const Wide3& b) {
-    using I = Wide3::Index;
-    const Wide3::Lanes a1 = __builtin_shuffle(a.l, I{1, 2, 0, 3}), b1 = __builtin_shuffle(b.l, I{2, 0, 1, 3});
-    const Wide3::Lanes a2 = __builtin_shuffle(a.l, I{2, 0, 1, 3}), b2 = __builtin_shuffle(b.l, I{1, 2, 0, 3});
+    const Wide3::Lanes a1 = shuffleLanes<1, 2, 0, 3>(a.l), b1 = shuffleLanes<2, 0, 1, 3>(b.l);
+    const Wide3::Lanes a2 = shuffleLanes<2, 0, 1, 3>(a.l), b2 = shuffleLanes<1, 2, 0, 3>(b.l);
     return {a1 * b1 - a2 * b2};
 }
 

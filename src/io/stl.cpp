@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <istream>
 #include <string_view>
 
 namespace haet {
@@ -84,7 +85,7 @@ Vec<3> unitNormal(const StlTriangle& t) {
 }
 
 /// Reads a binary file of n = count triangles whose size has been checked to be 84 + 50 n.
-void readBinary(std::ifstream& in, const fs::path& path, std::uint32_t count, StlMesh& mesh) {
+void readBinary(std::istream& in, const fs::path& path, std::uint32_t count, StlMesh& mesh) {
     mesh.triangles.reserve(count);
     constexpr std::size_t kChunk = 1024;  // records read at once: bounded buffer whatever the count
     std::vector<unsigned char> buf(kChunk * kRecord);
@@ -110,7 +111,7 @@ void readBinary(std::ifstream& in, const fs::path& path, std::uint32_t count, St
 /// The ASCII grammar as a stream of whitespace-separated words with their line numbers, line by line.
 class Words {
 public:
-    Words(std::ifstream& in, const fs::path& path) : in_(in), path_(path) {}
+    Words(std::istream& in, const fs::path& path) : in_(in), path_(path) {}
     /// The next word, or an empty view at the end of the file.
     std::string_view next() {
         for (;;) {
@@ -138,14 +139,14 @@ public:
     int line() const { return lineNo_; }
 
 private:
-    std::ifstream& in_;
+    std::istream& in_;
     const fs::path& path_;
     std::string line_;
     std::size_t pos_ = 0;
     int lineNo_ = 0;
 };
 
-void readAscii(std::ifstream& in, const fs::path& path, StlMesh& mesh) {
+void readAscii(std::istream& in, const fs::path& path, StlMesh& mesh) {
     in.seekg(0);
     Words w(in, path);
     std::size_t index = 0;  // 1-based index of the triangle being read, 0 outside a facet
@@ -229,6 +230,10 @@ StlMesh readStl(const std::filesystem::path& path) {
     std::error_code ec;
     if (!in || fs::is_directory(path, ec))
         throw StlError(path, fs::exists(path, ec) ? "cannot be read" : "no such file");
+    return readStl(in, path);
+}
+
+StlMesh readStl(std::istream& in, const std::filesystem::path& path) {
     in.seekg(0, std::ios::end);
     const auto end = in.tellg();
     if (end < 0) throw StlError(path, "cannot be read (size unknown)");

@@ -18,6 +18,7 @@
 #include <array>
 #include <cstddef>
 #include <filesystem>
+#include <istream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -66,6 +67,8 @@ struct StlMesh {
 /// a degenerate triangle (kStlDegenerateRatio). Memory is bounded by the file: a binary count is checked
 /// against the file's size before anything is allocated, and ASCII is read line by line.
 StlMesh readStl(const std::filesystem::path& path);
+/// The same from a seekable stream (what the file's overload reads; the fuzz target's entry), `path` naming it.
+StlMesh readStl(std::istream& in, const std::filesystem::path& path);
 
 /// Placement of a mesh: p' = R (S p) + T, in this order: scale about the origin of the file's coordinates, then
 /// rotate about that origin, then translate. A negative scale factor mirrors; with an odd number of them the

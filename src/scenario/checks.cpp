@@ -148,6 +148,12 @@ template <int D>
 void checkFileParticles(const Scenario& s, std::size_t k, const ParticleFile& pf) {
     const InsertDef& in = s.inserts[k];
     const std::string key = insertKey(k, "file");
+    // Centres first: the overlap test below bins them into cells of the domain, which a centre far outside it
+    // (1e92 m) would take beyond any cell index.
+    for (const FileParticle& fp : pf.particles)
+        for (int a = 0; a < D; ++a)
+            if (!(fp.x[a] >= s.domain.lo[a] && fp.x[a] <= s.domain.hi[a]))
+                throw ScenarioError({in.file, fp.line}, key, "particle centre lies outside the domain");
     double largest = 0;
     for (int a = 0; a < D; ++a) largest = std::max(largest, s.domain.hi[a] - s.domain.lo[a]);
     for (const FileParticle& fp : pf.particles)

@@ -20,10 +20,10 @@ void checkScenario(Scenario& s);
 /// MaterialDef::restitution as the loader leaves it when the file gives none (checkScenario resolves it).
 inline constexpr double kRestitutionUnset = -1;
 
-/// One particle file of insert k as read (each particle with its line): radii the box can hold, a LAMMPS box that is
-/// the domain's on every periodic axis (positions wrap, and image flags unwrap, by the scenario's box), and, for the
-/// hard particles of an event-driven or hybrid run, no two particles of the file overlapping (rejected, naming both
-/// lines: the engine would let them pass through each other). Called by the insertion. Throws ScenarioError.
+/// One particle file of insert k as read (each particle with its line): centres in the domain, radii it can hold, a
+/// LAMMPS box that is the domain's on every periodic axis (positions wrap, and image flags unwrap, by that box), and,
+/// for the hard particles of an event-driven or hybrid run, no two of the file's particles overlapping (rejected,
+/// naming both lines: the engine would let them pass through each other). Called by insertion. Throws ScenarioError.
 template <int D>
 void checkFileParticles(const Scenario& s, std::size_t k, const ParticleFile& pf);
 

@@ -64,15 +64,26 @@ std::optional<long long> parseInteger(std::string_view s) {
     return v;
 }
 
-/// The lines of a particle file one at a time, each without a trailing '\r' (files written on Windows).
+/// The lines of a particle file one at a time, each without a trailing '\r' (files written on Windows). A line is
+/// at most kMaxParticleLineBytes long and holds no NUL byte: anything else is not a particle file (a binary file, a
+/// device such as /dev/zero), and a line is never read whole into memory before that is known.
 class LineReader {
 public:
-    LineReader(const std::filesystem::path& file, const std::string& key) : in_(file) {
-        if (!in_) throw ScenarioError({file.string(), 0}, key, "cannot open the particle file");
-    }
+    LineReader(std::istream& in, const std::string& name, const std::string& key) : in_(in), name_(name), key_(key) {}
     /// The next line into `line`; false at the end of the file. lineNumber() is then its number, from 1.
     bool next(std::string& line) {
-        if (!std::getline(in_, line)) return false;
+        line.clear();
+        std::streambuf* buf = in_.rdbuf();
+        bool any = false;
+        for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
+            any = true;
+            if (c == '\n') break;
+            if (c == '\0') fail("a NUL byte: not a text file");
+            if (line.size() == kMaxParticleLineBytes)
+                fail("line longer than " + std::to_string(kMaxParticleLineBytes >> 20) + " MiB: not a particle file");
+            line.push_back(char(c));
+        }
+        if (!any) return false;
         if (!line.empty() && line.back() == '\r') line.pop_back();
         ++number_;
         return true;
@@ -80,15 +91,28 @@ public:
     int lineNumber() const { return number_; }
 
 private:
-    std::ifstream in_;
+    [[noreturn]] void fail(const std::string& what) const { throw ScenarioError({name_, number_ + 1}, key_, what); }
+
+    std::istream& in_;
+    const std::string& name_;
+    const std::string& key_;
     int number_ = 0;
 };
 
-std::vector<std::string> readLines(const std::filesystem::path& file, const std::string& key) {
-    LineReader reader(file, key);
+std::vector<std::string> readLines(std::istream& in, const std::string& name, const std::string& key) {
+    LineReader reader(in, name, key);
     std::vector<std::string> lines;
     for (std::string line; reader.next(line);) lines.push_back(std::move(line));
     return lines;
+}
+
+/// Opens a particle file for the readers below (binary: the '\r' of a line end is the reader's).
+std::ifstream openParticleFile(const std::filesystem::path& file, const std::string& key) {
+    std::ifstream in(file, std::ios::binary);
+    std::error_code ec;
+    if (!in || std::filesystem::is_directory(file, ec))
+        throw ScenarioError({file.string(), 0}, key, "cannot open the particle file");
+    return in;
 }
 
 /// The polygon of an insert with shape = "polygon", circumradius r, drawn after the particle's position.
@@ -335,9 +359,6 @@ std::vector<NewParticle<D>> insertFromFile(const Scenario& s, std::size_t k) {
     for (const FileParticle& fp : pf.particles) {
         NewParticle<D> p;
         p.x = toVec<D>(fp.x);
-        for (int a = 0; a < D; ++a)
-            if (p.x[a] < s.domain.lo[std::size_t(a)] || p.x[a] > s.domain.hi[std::size_t(a)])
-                throw ScenarioError({in.file, fp.line}, key, "particle centre lies outside the domain");
         p.v = toVec<D>(fp.v);
         if constexpr (D == 3) {
             p.w = toVec<3>(fp.w);
@@ -425,10 +446,9 @@ struct ColumnRecord {
 /// fields. header(col, fail) checks the columns present, record(r) reads one record. `what` names a record
 /// ("particle", "polygon") in the messages for a file without header or records.
 template <std::size_t N, class Header, class Record>
-void readColumnFile(const std::filesystem::path& file, const std::string& key, const char* const (&names)[N],
+void readColumnFile(std::istream& in, const std::string& name, const std::string& key, const char* const (&names)[N],
                     const char* known, const char* what, Header&& header, Record&& record) {
-    const std::string name = file.string();
-    const std::vector<std::string> lines = readLines(file, key);
+    const std::vector<std::string> lines = readLines(in, name, key);
     std::array<int, N> col;
     col.fill(-1);
     std::size_t fields = 0, records = 0;
@@ -461,6 +481,12 @@ void readColumnFile(const std::filesystem::path& file, const std::string& key, c
 }  // namespace
 
 ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
+                             const std::vector<MaterialDef>& materials, const std::string& key) {
+    std::ifstream in = openParticleFile(file, key);
+    return readParticleCsv(in, file.string(), dimension, materials, key);
+}
+
+ParticleFile readParticleCsv(std::istream& in, const std::string& name, int dimension,
                              const std::vector<MaterialDef>& materials, const std::string& key) {
     enum Column { X, Y, Z, Radius, Vx, Vy, Vz, Wx, Wy, Wz, Ix, Iy, Iz, Material, Frozen, kColumns };
     static const char* const columnName[kColumns] = {"x",  "y",  "z",  "radius", "vx", "vy",       "vz",    "wx",
@@ -506,7 +532,7 @@ ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
         if (r.has(Frozen)) p.frozen = frozenCell(r.cell(Frozen), r.fail);
         out.particles.push_back(p);
     };
-    readColumnFile(file, key, columnName,
+    readColumnFile(in, name, key, columnName,
                    "the header names columns x, y, z, radius, vx, vy, vz, wx, wy, wz, ix, iy, iz, material, frozen",
                    "particle", header, record);
     return out;
@@ -514,6 +540,12 @@ ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
 
 std::vector<FilePolygon> readPolygonCsv(const std::filesystem::path& file, const std::vector<MaterialDef>& materials,
                                         const std::string& key) {
+    std::ifstream in = openParticleFile(file, key);
+    return readPolygonCsv(in, file.string(), materials, key);
+}
+
+std::vector<FilePolygon> readPolygonCsv(std::istream& in, const std::string& name,
+                                        const std::vector<MaterialDef>& materials, const std::string& key) {
     enum Column { Vertices, Vx, Vy, W, Material, Frozen, kColumns };
     static const char* const columnName[kColumns] = {"vertices", "vx", "vy", "w", "material", "frozen"};
     std::vector<FilePolygon> out;
@@ -546,15 +578,19 @@ std::vector<FilePolygon> readPolygonCsv(const std::filesystem::path& file, const
         if (r.has(Frozen)) p.frozen = frozenCell(r.cell(Frozen), r.fail);
         out.push_back(std::move(p));
     };
-    readColumnFile(file, key, columnName, "a polygon file names columns vertices, vx, vy, w, material, frozen",
+    readColumnFile(in, name, key, columnName, "a polygon file names columns vertices, vx, vy, w, material, frozen",
                    "polygon", header, record);
     return out;
 }
 
 ParticleFile readLammpsData(const std::filesystem::path& file, const std::string& key) {
-    const std::string name = file.string();
+    std::ifstream in = openParticleFile(file, key);
+    return readLammpsData(in, file.string(), key);
+}
+
+ParticleFile readLammpsData(std::istream& in, const std::string& name, const std::string& key) {
     // Read line by line, not held whole: a 32 000-atom file is 7 MB of lines, which would set the run's peak.
-    LineReader reader(file, key);
+    LineReader reader(in, name, key);
     ParticleFile out;
     // LAMMPS's default box when the header gives none.
     Vec3d lo{-0.5, -0.5, -0.5}, hi{0.5, 0.5, 0.5};
@@ -608,7 +644,8 @@ ParticleFile readLammpsData(const std::filesystem::path& file, const std::string
                 }
                 if (tok.size() == 3 && tok[1] == "atom" && tok[2] == "types") {
                     const auto n = parseInteger(tok[0]);
-                    if (!n || *n < 1) fail("bad atom type count " + inQuotes(tok[0]));
+                    if (!n || *n < 1 || *n > std::numeric_limits<int>::max())
+                        fail("bad atom type count " + inQuotes(tok[0]));
                     out.atomTypes = int(*n);
                     continue;
                 }
@@ -640,7 +677,9 @@ ParticleFile readLammpsData(const std::filesystem::path& file, const std::string
                 const auto id = parseInteger(tok[0]);
                 const auto type = parseInteger(tok[1]);
                 if (!id) fail("Atoms line: bad atom id " + inQuotes(tok[0]));
-                if (!type || *type < 1) fail("Atoms line: atom type must be an integer >= 1, got " + inQuotes(tok[1]));
+                if (!type || *type < 1 || *type > std::numeric_limits<int>::max())
+                    fail("Atoms line: atom type must be an integer from 1 to " +
+                         std::to_string(std::numeric_limits<int>::max()) + ", got " + inQuotes(tok[1]));
                 if (out.atomTypes > 0 && *type > out.atomTypes)
                     fail("Atoms line: atom type " + std::to_string(*type) + " > atom types " +
                          std::to_string(out.atomTypes));
@@ -659,7 +698,9 @@ ParticleFile readLammpsData(const std::filesystem::path& file, const std::string
                 if (tok.size() == 10) {
                     for (std::size_t c = 0; c < 3; ++c) {
                         const auto f = parseInteger(tok[c + 7]);
-                        if (!f) fail("Atoms line: image flag must be an integer, got " + inQuotes(tok[c + 7]));
+                        if (!f || *f < std::numeric_limits<int>::min() || *f > std::numeric_limits<int>::max())
+                            fail("Atoms line: image flag must be an integer within +-2^31, got " +
+                                 inQuotes(tok[c + 7]));
                         p.image[c] = int(*f);
                     }
                 }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <istream>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -56,17 +57,26 @@ struct FilePolygon {
 /// either order, convex) in world coordinates. Errors: ScenarioError at the file's line, named `key`.
 std::vector<FilePolygon> readPolygonCsv(const std::filesystem::path& file, const std::vector<MaterialDef>& materials,
                                         const std::string& key);
+/// The same from a stream (what the file's overload reads; the fuzz target's entry), `name` naming it in errors.
+std::vector<FilePolygon> readPolygonCsv(std::istream& in, const std::string& name,
+                                        const std::vector<MaterialDef>& materials, const std::string& key);
+
+/// The longest line a particle file may hold (a CSV record of 20 vertices takes well under 1 kB).
+inline constexpr std::size_t kMaxParticleLineBytes = std::size_t(1) << 20;
 
 /// Reads a CSV particle file whose header names the columns x,y[,z],radius[,vx,vy[,vz]][,material][,frozen] in any
 /// order (z and vz only in 3D). A material is a name from `materials` or its 0-based index; frozen is 0/1/true/false.
 /// Blank lines and lines starting with '#' are skipped. Errors: ScenarioError at the file's line, named `key`.
 ParticleFile readParticleCsv(const std::filesystem::path& file, int dimension,
                              const std::vector<MaterialDef>& materials, const std::string& key);
+ParticleFile readParticleCsv(std::istream& in, const std::string& name, int dimension,
+                             const std::vector<MaterialDef>& materials, const std::string& key);
 
 /// Reads a LAMMPS data file written for atom_style sphere: header counts and box bounds, "Atoms # sphere" lines
 /// `id type diameter density x y z [ix iy iz]`, optional "Velocities" lines `id vx vy vz wx wy wz`.
 /// Particles keep the order of the Atoms section. Errors: ScenarioError at the file's line, named `key`.
 ParticleFile readLammpsData(const std::filesystem::path& file, const std::string& key);
+ParticleFile readLammpsData(std::istream& in, const std::string& name, const std::string& key);
 
 // ---- Placing particles: shared by [[insert]] and the inlets (run/flow.hpp) -----------------------------------------
 

@@ -375,7 +375,10 @@ private:
             // A file named on the command line is where the command was typed, as any path on a command line.
             if (p.is_relative()) p = (r.fromOverride("file") ? std::filesystem::current_path() : dir_) / p;
             std::error_code ec;
-            if (!std::filesystem::is_regular_file(p, ec)) r.fail("file", "file not found: " + p.string());
+            if (!std::filesystem::is_regular_file(p, ec))
+                r.fail("file", (std::filesystem::exists(p, ec) ? "not a regular file (a directory or a device): "
+                                                               : "file not found: ") +
+                                   p.string());
             in.file = p.string();
             in.format = r.choice<FileFormat>("format", {{"csv", FileFormat::Csv}, {"lammps", FileFormat::LammpsData}})
                             .value_or(FileFormat::Csv);

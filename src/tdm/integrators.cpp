@@ -3,6 +3,8 @@
 #include <cstring>
 #include <utility>
 
+#include "core/lane_shuffle.hpp"
+
 namespace haet {
 
 template <class T>
@@ -95,9 +97,12 @@ inline V4 load4(const double* p) {
 inline void store4(double* p, V4 v) { std::memcpy(p, &v, sizeof v); }
 inline V4 splat(double s) { return V4{s, s, s, s}; }
 
-/// Four particles with W components each fill W registers; element k of register R belongs to particle (4R + k) / W.
-template <int W, int R>
-inline constexpr V4i kSpread = {(4 * R) / W, (4 * R + 1) / W, (4 * R + 2) / W, (4 * R + 3) / W};
+/// Four particles with W components each fill W registers; element k of register R belongs to particle (4R + k) / W:
+/// the four particles' values v spread over register R's elements.
+template <int W, int R, class V>
+[[gnu::always_inline]] inline V spread(V v) {
+    return shuffleLanes<(4 * R) / W, (4 * R + 1) / W, (4 * R + 2) / W, (4 * R + 3) / W>(v);
+}
 
 /// Velocity Verlet on four particles' W-component quantity (position, velocity, mean velocity, force; or angle,
 /// spin, ...): Corrector then Predictor element by element; frozen particles (fz) keep everything and get mv = v.
@@ -110,14 +115,14 @@ template <int W, bool kAnyFrozen, bool kDrift = false, bool kPos = true>
     [&]<int... R>(std::integer_sequence<int, R...>) {
         (
             [&] {
-                const V4 s = __builtin_shuffle(scale, kSpread<W, R>);
+                const V4 s = spread<W, R>(scale);
                 const V4 mv0 = load4(mv + 4 * R);
                 const V4 a = load4(f + 4 * R) * s;
                 const V4 vi = mv0 + a * splat(h);   // the corrector: v(t + dt)
                 V4 mvn = vi + a * splat(0.5 * dt);  // the predictor of the next step
                 V4 vn = vi + a * splat(dt);
                 if constexpr (kAnyFrozen) {
-                    const V4i z = __builtin_shuffle(fz, kSpread<W, R>);
+                    const V4i z = spread<W, R>(fz);
                     const V4 v0 = load4(v + 4 * R);
                     vn = z ? v0 : vn;
                     mvn = z ? v0 : mvn;
@@ -125,7 +130,7 @@ template <int W, bool kAnyFrozen, bool kDrift = false, bool kPos = true>
                 if constexpr (kPos) {
                     const V4 x0 = load4(x + 4 * R);
                     V4 xn = x0 + (vi * splat(dt) + a * splat(h2));
-                    if constexpr (kAnyFrozen) xn = __builtin_shuffle(fz, kSpread<W, R>) ? x0 : xn;
+                    if constexpr (kAnyFrozen) xn = spread<W, R>(fz) ? x0 : xn;
                     store4(x + 4 * R, xn);
                     if constexpr (kDrift) {
                         const V4 d = xn - load4(ref + 4 * R);
@@ -145,12 +150,12 @@ template <int W, bool kAnyFrozen, bool kDrift = false, bool kPos = true>
 template <int D>
 [[gnu::always_inline]] inline V4 norms4(const V4* sq) {
     if constexpr (D == 2) {
-        return __builtin_shuffle(sq[0], sq[1], V4i{0, 2, 4, 6}) + __builtin_shuffle(sq[0], sq[1], V4i{1, 3, 5, 7});
+        return shuffleLanes<0, 2, 4, 6>(sq[0], sq[1]) + shuffleLanes<1, 3, 5, 7>(sq[0], sq[1]);
     } else {
         static_assert(D == 3);
-        const V4 x = __builtin_shuffle(__builtin_shuffle(sq[0], sq[1], V4i{0, 3, 6, 6}), sq[2], V4i{0, 1, 2, 5});
-        const V4 y = __builtin_shuffle(__builtin_shuffle(sq[0], sq[1], V4i{1, 4, 7, 7}), sq[2], V4i{0, 1, 2, 6});
-        const V4 z = __builtin_shuffle(__builtin_shuffle(sq[0], sq[1], V4i{2, 5, 5, 5}), sq[2], V4i{0, 1, 4, 7});
+        const V4 x = shuffleLanes<0, 1, 2, 5>(shuffleLanes<0, 3, 6, 6>(sq[0], sq[1]), sq[2]);
+        const V4 y = shuffleLanes<0, 1, 2, 6>(shuffleLanes<1, 4, 7, 7>(sq[0], sq[1]), sq[2]);
+        const V4 z = shuffleLanes<0, 1, 4, 7>(shuffleLanes<2, 5, 5, 5>(sq[0], sq[1]), sq[2]);
         return (x + y) + z;
     }
 }

@@ -5,6 +5,18 @@
 
 namespace haet {
 
+namespace {
+
+template <int N>
+bool allFinite(const std::vector<Vec<N>>& values) {
+    for (const Vec<N>& a : values)
+        for (int k = 0; k < N; ++k)
+            if (!std::isfinite(a[k])) return false;
+    return true;
+}
+
+}  // namespace
+
 template <int D>
 void saveWorld(ByteWriter& out, const World<D>& w) {
     const Particles<D>& p = w.particles;
@@ -81,6 +93,19 @@ void loadWorld(ByteReader& in, World<D>& w) {
         if (int(m) >= w.contact.nMaterials) in.fail("a particle's material is not in the scenario");
     for (double r : q.radius)
         if (!(r > 0) || !std::isfinite(r)) in.fail("a radius is not a positive number");
+    // A run stops at the first non-finite state (exit code 3), so a saved one is finite; the engines' grids take a
+    // position's cell by a conversion to int that a NaN would make undefined.
+    if (!allFinite(q.x) || !allFinite(q.v) || !allFinite(q.w)) in.fail("a position, velocity or spin is not finite");
+    // The grids clamp a point beyond the box into their border cells after converting its cell coordinate to int,
+    // which a position of 1e294 m overflows. kMaxBoxLengths box lengths from the box is far beyond any flight of a
+    // run and within int for every grid of up to 2^21 cells along an axis.
+    constexpr double kMaxBoxLengths = 1000;
+    double extent = 0;
+    for (int k = 0; k < D; ++k) extent = std::max(extent, w.domain.hi[k] - w.domain.lo[k]);
+    for (const Vec<D>& x : q.x)
+        for (int k = 0; k < D; ++k)
+            if (std::abs(x[k] - 0.5 * (w.domain.lo[k] + w.domain.hi[k])) > (kMaxBoxLengths + 0.5) * extent)
+                in.fail("a position lies more than 1000 box lengths from the box");
     q.nTdm = nTdm;
     p = std::move(q);
     w.time = time;
