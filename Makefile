@@ -39,9 +39,10 @@ test: build
 	cd $(BUILD) && ctest -L fast --output-on-failure -j $(JOBS)
 
 # The fast tests built with AddressSanitizer and UndefinedBehaviorSanitizer (GCC, -O1): only the test programs
-# and haet, which the command line's tests run. Tests labelled nosanitize are left out.
+# and haet, which the command line's tests run (not the Python module: the interpreter is not instrumented).
+# Tests labelled nosanitize are left out.
 test-sanitize: deps
-	cmake -S . -B $(SAN_BUILD) -DCMAKE_BUILD_TYPE=Release -DHAET_SANITIZE=ON >/dev/null
+	cmake -S . -B $(SAN_BUILD) -DCMAKE_BUILD_TYPE=Release -DHAET_SANITIZE=ON -DHAET_PYTHON=OFF >/dev/null
 	cmake --build $(SAN_BUILD) -j $(JOBS) --target haet haet_tests
 	cd $(SAN_BUILD) && $(SANITIZE_ENV) ctest -L fast -LE nosanitize --output-on-failure -j $(JOBS)
 
