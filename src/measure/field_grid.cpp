@@ -32,6 +32,30 @@ void gaussLegendre01(int n, double* nodes, double* weights) {
     }
 }
 
+namespace {
+
+/// The shares of cells q0..q1 of one axis (lower edge lo, width h, n cells) from below(e), the part of a weight
+/// below the edge e: a cell's share is below(its upper edge) - below(its lower edge), so the shares sum to the
+/// whole weight exactly; on a periodic axis the cell wraps, on another a cell outside the grid is dropped.
+template <class Below>
+void cellShares(double lo, double h, int n, bool wraps, long q0, long q1, Below below,
+                std::vector<std::pair<int, double>>& out) {
+    double prev = below(lo + static_cast<double>(q0) * h);
+    for (long q = q0; q <= q1; ++q) {
+        const double next = below(lo + static_cast<double>(q + 1) * h);
+        const double s = next - prev;
+        prev = next;
+        long c = q;
+        if (wraps)
+            c = ((q % n) + n) % n;
+        else if (q < 0 || q >= n)
+            continue;
+        if (s != 0) out.emplace_back(static_cast<int>(c), s);
+    }
+}
+
+}  // namespace
+
 template <int D>
 CgGrid<D>::CgGrid(const CgGridSpec<D>& spec) : spec_(spec) {
     ncells_ = 1;
@@ -56,18 +80,9 @@ void CgGrid<D>::pointShares(int a, double p, std::vector<std::pair<int, double>>
     const double lo = spec_.lo[k], h = h_[a], r = k_[a].support();
     const long q0 = static_cast<long>(std::floor((p - r - lo) / h));
     const long q1 = static_cast<long>(std::floor((p + r - lo) / h));
-    double below = k_[a].cdf(lo + static_cast<double>(q0) * h - p);
-    for (long q = q0; q <= q1; ++q) {
-        const double next = k_[a].cdf(lo + static_cast<double>(q + 1) * h - p);
-        const double s = next - below;
-        below = next;
-        long c = q;
-        if (spec_.wraps[k])
-            c = ((q % n) + n) % n;
-        else if (q < 0 || q >= n)
-            continue;
-        if (s != 0) out.emplace_back(static_cast<int>(c), s);
-    }
+    const CgKernel1d& kr = k_[a];
+    cellShares(
+        lo, h, n, spec_.wraps[k], q0, q1, [&](double e) { return kr.cdf(e - p); }, out);
 }
 
 template <int D>
@@ -84,19 +99,9 @@ void CgGrid<D>::segmentShares(int a, double p, double db, std::vector<std::pair<
     const long q0 = static_cast<long>(std::floor((std::min(pa, pb) - r - lo) / h));
     const long q1 = static_cast<long>(std::floor((std::max(pa, pb) + r - lo) / h));
     // The share of the segment's kernels below edge e, averaged along it: (I(e - pb) - I(e - pa)) / (pa - pb).
-    auto below = [&](double e) { return (kr.cdfIntegral(e - pb) - kr.cdfIntegral(e - pa)) / db; };
-    double prev = below(lo + static_cast<double>(q0) * h);
-    for (long q = q0; q <= q1; ++q) {
-        const double next = below(lo + static_cast<double>(q + 1) * h);
-        const double s = next - prev;
-        prev = next;
-        long c = q;
-        if (spec_.wraps[k])
-            c = ((q % n) + n) % n;
-        else if (q < 0 || q >= n)
-            continue;
-        if (s != 0) out.emplace_back(static_cast<int>(c), s);
-    }
+    cellShares(
+        lo, h, n, spec_.wraps[k], q0, q1,
+        [&](double e) { return (kr.cdfIntegral(e - pb) - kr.cdfIntegral(e - pa)) / db; }, out);
 }
 
 template <int D>
