@@ -10,8 +10,9 @@ DEB_PACKAGES = cmake g++ make pkg-config libgtest-dev libbenchmark-dev libtomlpl
 FUZZ_DEB_PACKAGES = clang libclang-rt-14-dev libomp-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-# Sanitizer reports: leaks too, stop at the first report, with its stack.
+# Sanitizer reports: leaks too (but those tests/lsan.supp names), stop at the first report, with its stack.
 SANITIZE_ENV = ASAN_OPTIONS=detect_leaks=1:halt_on_error=1:abort_on_error=1:print_stacktrace=1 \
+               LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
                UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 
 .PHONY: all deps fuzz-deps build python test test-sanitize fuzz validate demo bench clean
