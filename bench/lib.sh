@@ -37,13 +37,20 @@ setup() {
 # The functions below use `haet` (the binary) and `out` (a directory), as setup leaves them.
 
 # run NAME SCENARIO [--set KEY=VALUE ...]: runs one scenario on one thread into $out/NAME, with the overrides
-# given; sets CPU (user + sys, s) and WALL (s).
+# given; sets CPU (user + sys, s) and WALL (s). Returns haet's exit status when the run fails (a scene a method
+# refuses, say), after saying so: callers that go on without it test the status (`if run ...`), for under `if`
+# bash does not stop at the failed command itself.
 run() {
-    local name=$1 scenario=$2
+    local name=$1 scenario=$2 rc=0
     shift 2
     /usr/bin/time -f "%U %S %e" -o "$out/$name.time" "$haet" run "$scenario" "$@" --out "$out/$name" --threads 1 \
-        --quiet
-    read -r user sys wall <"$out/$name.time"
+        --quiet || rc=$?
+    if [ "$rc" -ne 0 ]; then
+        echo "$name: haet exited with status $rc" >&2
+        return "$rc"
+    fi
+    # time's last line holds the figures (a line before it reports a signal or a status)
+    read -r user sys wall < <(tail -n 1 "$out/$name.time")
     CPU=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.2f", u + s }')
     WALL=$wall
 }
