@@ -164,5 +164,69 @@ TEST(CgGrid, ZeroWidthCountsWholeParticlesAndClipsBranches) {
     EXPECT_NEAR(f.contactStress[0], 0.4 * 0.25, 1e-15);
 }
 
+// A region over part of a periodic axis sees the periodic images: its cells equal those of a grid over the whole
+// periodic box (which wraps) where the two overlap, for particles and branches that cross the box's face.
+TEST(CgGrid, PartOfAPeriodicAxisSeesTheImages) {
+    for (CgKernelKind kind : {CgKernelKind::Gaussian, CgKernelKind::Lucy}) {
+        CgGridSpec<3> whole;
+        whole.nAxes = 1;
+        whole.axis = {0, 1, 2};
+        whole.cells = {40, 1, 1};
+        whole.lo = Vec<3>{{0, 0, 0}};
+        whole.hi = Vec<3>{{10, 1, 1}};
+        whole.wraps = {true, false, false};
+        whole.kernel = kind;
+        whole.width = 0.6;
+        CgGridSpec<3> part = whole;  // [8, 10) and, by images, nothing more: cells 32..39 of the whole
+        part.cells = {8, 1, 1};
+        part.lo[0] = 8;
+        part.wraps = {false, false, false};
+        part.period = {10, 0, 0};
+        CgGridSpec<3> low = part;  // [0, 3): cells 0..11 of the whole
+        low.cells = {12, 1, 1};
+        low.lo[0] = 0;
+        low.hi[0] = 3;
+        CgGrid<3> gw(whole), gp(part), gl(low);
+        std::mt19937_64 rng(3);
+        std::uniform_real_distribution<double> u(0, 1), vel(-1, 1);
+        for (int i = 0; i < 200; ++i) {
+            // Near the face x = 0 = 10 (some a little outside, as between pair-list rebuilds).
+            const double x0 = u(rng) < 0.5 ? -0.2 + 1.6 * u(rng) : 8.6 + 1.6 * u(rng);
+            const Vec<3> x{{x0, u(rng), u(rng)}}, v{{vel(rng), vel(rng), vel(rng)}};
+            const Vec<3> b{{0.9 * vel(rng), 0.1 * vel(rng), 0.1 * vel(rng)}}, f{{vel(rng), vel(rng), vel(rng)}};
+            for (CgGrid<3>* g : {&gw, &gp, &gl}) {
+                g->addParticle(x, 1.0, 0.5, true, v);
+                g->addContact(x, b, f);
+            }
+        }
+        const std::vector<double>&w = gw.sums(), &p = gp.sums(), &l = gl.sums();
+        for (int ch = 0; ch < CgLayout<3>::kChannels; ++ch) {
+            for (int c = 0; c < 8; ++c)
+                EXPECT_NEAR(p[ch * 8 + c], w[ch * 40 + 32 + c], 1e-12) << "channel " << ch << " cell " << c;
+            for (int c = 0; c < 12; ++c)
+                EXPECT_NEAR(l[ch * 12 + c], w[ch * 40 + c], 1e-12) << "channel " << ch << " cell " << c;
+        }
+    }
+    // Across the axis: a box region [0, 5) of a periodic x of length 10, profiles over z. A particle at x = -0.1
+    // (the image 9.9 is outside) is outside; one at 10.2 is inside as 0.2; a branch from 9.8 to 10.3 lies 0.3 of
+    // 0.5 inside.
+    CgGridSpec<3> s;
+    s.nAxes = 1;
+    s.axis = {2, 0, 1};
+    s.cells = {1, 1, 1};
+    s.lo = Vec<3>{{0, 0, 0}};
+    s.hi = Vec<3>{{5, 1, 1}};
+    s.period = {10, 0, 0};
+    s.width = 0;
+    CgGrid<3> g(s);
+    g.addParticle(Vec<3>{{-0.1, 0.5, 0.5}}, 2.0, 0.1, true, Vec<3>::zero());
+    g.addParticle(Vec<3>{{10.2, 0.5, 0.5}}, 3.0, 0.1, true, Vec<3>::zero());
+    g.addContact(Vec<3>{{9.8, 0.5, 0.5}}, Vec<3>{{-0.5, 0, 0}}, Vec<3>{{-1, 0, 0}});
+    g.endSample();
+    const CgFields<3> f = g.fields(0);
+    EXPECT_DOUBLE_EQ(f.density[0] * 5, 3.0);
+    EXPECT_NEAR(f.contactStress[0] * 5, 0.5 * 0.6, 1e-15);
+}
+
 }  // namespace
 }  // namespace haet

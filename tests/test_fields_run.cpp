@@ -109,6 +109,119 @@ TEST(ContactNetwork, RecordingChangesNothing) {
         }
 }
 
+/// The contacts of the state at construction (the outputs at the start time): the constructor's pass again, so the
+/// records are the forces in the store bit for bit, and the run goes on as one that never recorded.
+TEST(ContactNetwork, StartContactsAreTheFirstPassBitForBit) {
+    const Scenario sc = testing::linearScenario(3, 0.7, 1e-4, 0.5, TangentialLaw::Spring);
+    const double a = 0.001, rho = 2500;
+    auto world = [&] {
+        World<3> w;
+        w.domain = testing::openBox<3>(0.05);
+        w.domain.gravity = Vec<3>{{0, 0, -9.81}};
+        w.particles.add(Vec<3>{{0, 0, a * 0.999}}, Vec<3>{{0.05, 0.02, -0.01}}, Ang<3>{{0.0, 3.0, 1.0}}, a, rho, 0, 0);
+        w.particles.add(Vec<3>{{1.9 * a, 0.3 * a, 0.998 * a}}, Vec<3>{{-0.05, 0, 0.01}}, Ang<3>{{1, 0, 0}}, a, rho, 0,
+                        1);
+        Wall<3> floor = Wall<3>::plane(Vec<3>::zero(), Vec<3>{{0, 0, 1}}, Vec<3>::zero(), 0);
+        floor.id = 0;
+        w.walls.push_back(floor);
+        w.contact = buildContactSetup<3>(sc, testing::statsOf(w.particles, 1));
+        return w;
+    };
+    World<3> wa = world(), wb = world();
+    TdmSettings s;
+    s.dt = wa.contact.contactTime / 50;
+    s.skin = a;
+    s.sortEvery = 0;
+    TdmEngine<3> ea(wa, s), eb(wb, s);
+    ContactSink<3> sink;
+    ASSERT_TRUE(eb.recordStartContacts(&sink));
+    EXPECT_EQ(eb.contactsRecordedAt(), wb.time);
+    ASSERT_EQ(sink.size(), 3u);  // the pair and each sphere on the floor
+    const Particles<3>& p = wb.particles;
+    for (std::size_t i = 0; i < 2; ++i) {
+        Vec<3> f = Vec<3>::zero();
+        for (const ContactRecord<3>& r : sink) {
+            if (r.i == i) f += r.fn + r.ft;
+            if (r.j == i) f -= r.fn + r.ft;
+        }
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(p.f[i][k], f[k] + p.mass[i] * wb.domain.gravity[k], 1e-12) << i;
+        for (int k = 0; k < 3; ++k) EXPECT_EQ(p.f[i][k], wa.particles.f[i][k]) << i;
+    }
+    for (int k = 0; k < 20; ++k) {
+        ea.step();
+        eb.step();
+    }
+    EXPECT_FALSE(eb.recordStartContacts(&sink));  // not after a step
+    for (std::size_t i = 0; i < 2; ++i)
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_EQ(wa.particles.x[i][k], wb.particles.x[i][k]);
+            EXPECT_EQ(wa.particles.w[i][k], wb.particles.w[i][k]);
+        }
+}
+
+/// Polygons (and disks among them) have their contact network too, through the polygon kernel's one-pair path:
+/// every particle's force is gravity plus its records' forces, the records' normal and tangential parts are
+/// orthogonal, and a run that records at every step ends as one that does not, bit for bit.
+TEST(ContactNetwork, PolygonRecordsSumToTheForces) {
+    struct Case {
+        const char* name;
+        std::vector<std::string> overrides;
+    };
+    // The pile; the box with disks among its hexagons.
+    const std::vector<Case> cases = {{"pile2d_polygons.toml", {}},
+                                     {"box2d_polygons.toml",
+                                      {"contact.duration=5e-4",
+                                       "insert[2]={ arrangement = \"random\", count = 300, radius = [0.0015, 0.002], "
+                                       "material = \"grain\", region = { lo = [0.0, 0.075], hi = [0.1, 0.15] } }"}}};
+    for (const Case& c : cases) {
+        const char* name = c.name;
+        const Scenario sc = testing::exampleScenario(name, c.overrides);
+        World<2> a = buildWorld<2>(sc), b = buildWorld<2>(sc);
+        std::string note;
+        TdmEngine<2> ea(a, tdmSettings<2>(sc, a, &note)), eb(b, tdmSettings<2>(sc, b, &note));
+        ea.advanceTo(0.15);
+        eb.advanceTo(0.15);
+        ContactSink<2> sink;
+        std::size_t walls = 0, pairs = 0;
+        for (int k = 0; k < 50; ++k) {
+            eb.recordContactsAt(&sink, eb.timeAfter(1));
+            eb.advanceTo(eb.timeAfter(1));
+        }
+        ea.advanceTo(eb.timeAfter(0));
+        const Particles<2>& p = b.particles;
+        std::vector<Vec<2>> f(p.size(), Vec<2>::zero());
+        double scale = 0;
+        for (const ContactRecord<2>& r : sink) {
+            const Vec<2> fr = r.fn + r.ft;
+            f[r.i] += fr;
+            if (r.j == ContactRecord<2>::kWall) {
+                ++walls;
+                EXPECT_GE(r.wall, 0);
+            } else {
+                ++pairs;
+                f[r.j] -= fr;
+            }
+            EXPECT_NEAR(norm(r.normal), 1.0, 1e-12);
+            EXPECT_NEAR(dot(r.fn, r.ft), 0.0, 1e-9 * norm2(fr) + 1e-300);
+            EXPECT_GE(dot(r.fn, r.normal), 0.0);
+            EXPECT_GT(r.overlap, 0.0);
+            scale = std::max(scale, norm(fr));
+        }
+        EXPECT_GT(pairs, p.size() / 2) << name;
+        EXPECT_GT(walls, 10u) << name;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            if (p.flags[i] & kFrozen) continue;
+            for (int k = 0; k < 2; ++k)
+                EXPECT_NEAR(p.f[i][k], f[i][k] + p.mass[i] * b.domain.gravity[k], 1e-9 * scale) << name << " " << i;
+        }
+        for (std::size_t i = 0; i < p.size(); ++i)
+            for (int k = 0; k < 2; ++k) {
+                ASSERT_EQ(a.particles.x[i][k], b.particles.x[i][k]) << name << " " << i;
+                ASSERT_EQ(a.particles.v[i][k], b.particles.v[i][k]) << name << " " << i;
+            }
+    }
+}
+
 fs::path runExample(const std::string& name, const std::vector<std::string>& overrides = {}) {
     const Scenario sc = testing::exampleScenario(name, overrides);
     RunOptions o;

@@ -89,6 +89,7 @@ public:
     /// The measurements' hooks (run/measures.hpp): the time-driven contacts of the step ending at t
     /// (TdmEngine::recordContactsAt), every event-driven collision (EdmEngine::setObserver).
     void recordContactsAt(ContactSink<D>* sink, double t) { tdm_->recordContactsAt(sink, t); }
+    bool recordStartContacts(ContactSink<D>* sink) { return tdm_->recordStartContacts(sink); }
     void setCollisionHook(std::function<void(const EdmCollision<D>&)> f) { edm_->setObserver(std::move(f)); }
     const ZoneGrid<D>& zones() const { return zones_; }
     const HaetSettings& settings() const { return hs_; }

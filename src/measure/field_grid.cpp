@@ -158,8 +158,40 @@ void CgGrid<D>::deposit(const std::vector<std::pair<int, double>>* shares, int c
 }
 
 template <int D>
+template <class Add>
+void CgGrid<D>::forImages(const Vec<D>& x, const Vec<D>& lo, const Vec<D>& hi, Add add) const {
+    // Up to three images per axis (the region lies in the box, a position at most a skin outside it): the shifts
+    // -L, 0, +L of each axis with a period that reach into [region lo, region hi), combined over the axes.
+    std::array<std::array<double, 3>, D> shifts;
+    std::array<int, D> count;
+    for (int k = 0; k < D; ++k) {
+        const double len = spec_.period[k];
+        count[k] = 0;
+        if (len == 0) {
+            shifts[k][count[k]++] = 0;
+            continue;
+        }
+        double r = 0;
+        for (int a = 0; a < spec_.nAxes; ++a)
+            if (spec_.axis[a] == k) r = k_[a].support();
+        for (double s : {0.0, -len, len})
+            if (x[k] + s + hi[k] + r >= spec_.lo[k] && x[k] + s + lo[k] - r < spec_.hi[k]) shifts[k][count[k]++] = s;
+    }
+    for (int k = 0; k < D; ++k)
+        if (count[k] == 0) return;  // no image reaches the region
+    std::array<int, D> q{};
+    for (;;) {
+        Vec<D> xs = x;
+        for (int k = 0; k < D; ++k) xs[k] += shifts[k][q[k]];
+        add(xs);
+        int k = 0;
+        while (k < D && ++q[k] >= count[k]) q[k++] = 0;
+        if (k == D) return;
+    }
+}
+
+template <int D>
 void CgGrid<D>::addParticle(const Vec<D>& x, double mass, double volume, bool tdm, const Vec<D>& v) {
-    if (!inTransverse(x)) return;
     double values[3 + D + D * D];
     values[kCgMass] = mass;
     values[kCgVolume] = volume;
@@ -168,12 +200,25 @@ void CgGrid<D>::addParticle(const Vec<D>& x, double mass, double volume, bool td
         values[L::kMomentum + a] = mass * v[a];
         for (int b = 0; b < D; ++b) values[L::kMvv + a * D + b] = mass * v[a] * v[b];
     }
+    forImages(x, Vec<D>::zero(), Vec<D>::zero(), [&](const Vec<D>& xs) { addParticleImage(xs, values); });
+}
+
+template <int D>
+void CgGrid<D>::addParticleImage(const Vec<D>& x, const double* values) {
+    if (!inTransverse(x)) return;
     for (int a = 0; a < spec_.nAxes; ++a) pointShares(a, x[spec_.axis[a]], sh_[a]);
     deposit(sh_, 0, values, 3 + D + D * D, 1.0);
 }
 
 template <int D>
 void CgGrid<D>::addSegment(const Vec<D>& x, const Vec<D>& b, const Vec<D>& f, int channel) {
+    Vec<D> lo, hi;  // the segment x -> x - b relative to x
+    for (int k = 0; k < D; ++k) lo[k] = std::min(0.0, -b[k]), hi[k] = std::max(0.0, -b[k]);
+    forImages(x, lo, hi, [&](const Vec<D>& xs) { addSegmentImage(xs, b, f, channel); });
+}
+
+template <int D>
+void CgGrid<D>::addSegmentImage(const Vec<D>& x, const Vec<D>& b, const Vec<D>& f, int channel) {
     double s0, s1;
     if (!transverseClip(x, b, s0, s1)) return;
     double t[D * D];

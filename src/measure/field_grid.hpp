@@ -25,6 +25,9 @@ struct CgGridSpec {
     std::array<int, 3> cells{1, 1, 1};  ///< cells along each grid axis
     Vec<D> lo, hi;                      ///< the region [m]
     std::array<bool, 3> wraps{};        ///< per box axis: periodic and the region spans the box (the kernel wraps)
+    /// Per box axis: the box's length when the axis is periodic and the region covers only part of it (then a
+    /// particle's and a branch's periodic images count where they reach into the region); 0 otherwise [m].
+    std::array<double, 3> period{};
     CgKernelKind kernel = CgKernelKind::Gaussian;
     double width = 0;   ///< [m] (cg_kernel.hpp)
     double cutoff = 3;  ///< Gaussian cut-off in widths
@@ -110,6 +113,12 @@ private:
     /// The part [s0, s1] of the segment x -> x - b inside the region along the axes not in the grid.
     bool transverseClip(const Vec<D>& x, const Vec<D>& b, double& s0, double& s1) const;
     void addSegment(const Vec<D>& x, const Vec<D>& b, const Vec<D>& f, int channel);
+    void addParticleImage(const Vec<D>& x, const double* values);
+    void addSegmentImage(const Vec<D>& x, const Vec<D>& b, const Vec<D>& f, int channel);
+    /// Calls add(image of x) for each periodic image (spec.period) of the extent [x + lo, x + hi] that reaches
+    /// into the region (along grid axes widened by the kernel's support); x itself when no axis has a period.
+    template <class Add>
+    void forImages(const Vec<D>& x, const Vec<D>& lo, const Vec<D>& hi, Add add) const;
     /// Adds value * (outer product of the shares) to `count` channels starting at `channel`.
     void deposit(const std::vector<std::pair<int, double>>* shares, int channel, const double* values, int count,
                  double scale);

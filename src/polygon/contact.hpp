@@ -68,6 +68,7 @@ struct ContactForce {
     double fn = 0;       ///< normal force [N]
     V2 normal{};         ///< unit normal, from j to i
     V2 point{};          ///< force point, in the frame of the bodies' x [m]
+    V2 ft{};             ///< the tangential part of f [N] (f = normal fn + ft)
     double length = 0;   ///< characteristic length l [m] (overlap-area law; 0 for the potential law)
 };
 
@@ -163,7 +164,8 @@ template <class Law, bool kFriction>
             s = -(ft + ct * gt) / c.kt;
         }
         xi = t * s;
-        f += t * ft;
+        out.ft = t * ft;
+        f += out.ft;
     }
     out.f = f;
     out.torqueI = cross2(ri, f);

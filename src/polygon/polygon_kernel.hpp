@@ -109,9 +109,11 @@ struct PolygonViews {
 /// Evaluates pair slot k of particle i and partner j (at least one of the two a polygon) with the pair's spring
 /// hist: whether it touches, and its entry (kEnergy: its elastic energy instead, hist a copy) when it does. Frame:
 /// origin at x_j. Inlined into the pass: a call per pair cost as much as the rejection of a pair that does not touch.
+/// With rec (the contact network's pass) also the contact as the law computed it.
 template <class Law, bool kFriction, bool kEnergy = false>
 [[gnu::always_inline]] inline bool evalPolygonPair(const PolygonViews& in, std::size_t i, std::uint32_t k,
-                                                   std::uint32_t j, V2& hist, PolygonEntry& out, double& energy) {
+                                                   std::uint32_t j, V2& hist, PolygonEntry& out, double& energy,
+                                                   ContactRecord<2>* rec = nullptr) {
     const Particles<2>& p = in.p;
     const PairList<2>& pl = in.pl;
     const ContactSetup& cs = in.cs;
@@ -165,6 +167,18 @@ template <class Law, bool kFriction, bool kEnergy = false>
     // Depth of the overlap, area / chord, relative to the smaller bounding radius (1 when the chord vanishes).
     const double clen = norm(o.chord);
     out.ovl = clen > 0 ? o.area / clen / rmin : 1.0;
+    if (rec) [[unlikely]] {
+        rec->i = static_cast<std::uint32_t>(i);
+        rec->j = j;
+        rec->wall = -1;
+        rec->normal = cf.normal;
+        rec->fn = cf.normal * cf.fn;
+        rec->ft = cf.ft;
+        rec->branch = d;
+        rec->position = p.x[i];
+        rec->point = p.x[i] - d + cf.point;  // the force point, from the frame of x_j's image by the pair's shift
+        rec->overlap = clen > 0 ? o.area / clen : rmin;
+    }
     return true;
 }
 
@@ -185,8 +199,10 @@ public:
           shape_(ctx.p.shape.data()),
           surfaces_(ctx, ps.rotated) {}
 
-    [[gnu::always_inline]] bool add(std::size_t i, std::size_t w, V2& f, Ang<2>& tq, double& worst) const {
-        if (shape_[i] == kNoShape) return disk_.add(i, w, f, tq, worst);
+    /// With rec (the contact network's pass) also the contact as the law computed it.
+    [[gnu::always_inline]] bool add(std::size_t i, std::size_t w, V2& f, Ang<2>& tq, double& worst,
+                                    ContactRecord<2>* rec = nullptr) const {
+        if (shape_[i] == kNoShape) return disk_.add(i, w, f, tq, worst, rec);
         // Most walls are beyond the bounding circle: that test first, the overlap out of line.
         const double dist = walls_[w].distanceNow(x_[i]);
         V2& hist = history_[i * nw_ + w];
@@ -196,13 +212,14 @@ public:
             return false;
         }
         double energy;
-        return contact<false>(i, w, dist, hist, f, tq, worst, energy);
+        return contact<false>(i, w, dist, hist, f, tq, worst, energy, rec);
     }
 
     /// Walls of any shape: a disk by the disk kernel (tdm/surface_kernel.hpp), a polygon by its overlap with the solid
     /// behind each element (surface_kernel.hpp).
-    [[gnu::always_inline]] std::uint32_t addSurfaces(std::size_t i, V2& f, Ang<2>& tq, double& worst) const {
-        return shape_[i] == kNoShape ? disk_.addSurfaces(i, f, tq, worst) : surfaces_.add(i, f, tq, worst);
+    [[gnu::always_inline]] std::uint32_t addSurfaces(std::size_t i, V2& f, Ang<2>& tq, double& worst,
+                                                     ContactSink<2>* sink = nullptr) const {
+        return shape_[i] == kNoShape ? disk_.addSurfaces(i, f, tq, worst, sink) : surfaces_.add(i, f, tq, worst, sink);
     }
     double surfaceEnergy(std::size_t i) const {
         return shape_[i] == kNoShape ? disk_.surfaceEnergy(i) : surfaces_.energy(i);
@@ -225,7 +242,7 @@ private:
     /// The contact of a polygon i within its bounding radius of wall w (at distance dist).
     template <bool kEnergy>
     [[gnu::noinline]] bool contact(std::size_t i, std::size_t w, double dist, V2& hist, V2& f, Ang<2>& tq,
-                                   double& worst, double& energy) const {
+                                   double& worst, double& energy, ContactRecord<2>* rec = nullptr) const {
         const Wall<2>& wall = walls_[w];
         const double ri = radius_[i];
         // Frame: origin at x_i.
@@ -254,6 +271,20 @@ private:
         if (ctx_.planeForce) ctx_.planeForce[i * nw_ + w] = cf.f;
         const double clen = norm(o.chord);
         worst = std::max(worst, clen > 0 ? o.area / clen / ri : 1.0);
+        if (rec) [[unlikely]] {
+            // The force point projected onto the wall: the branch ends on its surface, as a disk's does.
+            const V2 at = x_[i] + cf.point;
+            rec->i = static_cast<std::uint32_t>(i);
+            rec->j = ContactRecord<2>::kWall;
+            rec->wall = wall.id;
+            rec->normal = wall.normal;
+            rec->fn = cf.normal * cf.fn;
+            rec->ft = cf.ft;
+            rec->overlap = clen > 0 ? o.area / clen : ri;
+            rec->position = x_[i];
+            rec->point = at - wall.normal * wall.distanceNow(at);
+            rec->branch = x_[i] - rec->point;
+        }
         return true;
     }
 
@@ -324,6 +355,25 @@ public:
         }
         double energy;
         return evalPolygonPair<Law, Tangential::kHasHistory>(views_, i, k, j, in_.history[k], e, energy);
+    }
+
+    /// One listed pair as pair() evaluates it (the same bits), with the law's parts into rec (the contact network).
+    bool record(std::size_t i, std::uint32_t k, std::uint32_t j, Entry& e, ContactRecord<2>& rec) const {
+        if (shape_[i] == kNoShape && shape_[j] == kNoShape) {
+            PairForce<2> pf;
+            LawParts<2> parts;
+            double overlap = 0, vir = 0;
+            if (!evalPair<2, Normal, Tangential>(in_, Owner<2>(in_, i), k, pf, overlap, vir, &parts)) return false;
+            e.f = pf.f;
+            e.ti = -in_.radius[i] * pf.nxft[0];
+            e.tj = -in_.radius[j] * pf.nxft[0];
+            e.vir = vir;
+            e.ovl = overlap;
+            pairRecord(in_, i, j, parts, rec);
+            return true;
+        }
+        double energy;
+        return evalPolygonPair<Law, Tangential::kHasHistory>(views_, i, k, j, in_.history[k], e, energy, &rec);
     }
 
     /// The energy of listed pair k at the current state [J]: two disks' by their law, a polygon contact's from its

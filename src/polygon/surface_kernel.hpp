@@ -126,8 +126,9 @@ public:
         : ctx_(ctx), s_(ctx.surfaces), rotated_(rotated) {}
 
     /// Adds polygon i's contacts with walls of any shape to its force f and torque tq, and their depth A / |c| over
-    /// its radius to worst; returns how many touch.
-    std::uint32_t add(std::size_t i, V2& f, Ang<2>& tq, double& worst) const {
+    /// its radius to worst; returns how many touch. With sink (the contact network's pass) also the contacts as the
+    /// law computed them (the point: the force point).
+    std::uint32_t add(std::size_t i, V2& f, Ang<2>& tq, double& worst, ContactSink<2>* sink = nullptr) const {
         SurfaceState<2>& s = *s_;
         const std::uint32_t base = s.slotOf[i];
         if (base == SurfaceState<2>::kNoSlots) return 0;
@@ -170,6 +171,19 @@ public:
             const double clen = norm(h.o.chord);
             c.overlap = clen > 0 ? h.o.area / clen : ri;
             worst = std::max(worst, c.overlap / ri);
+            if (sink) [[unlikely]] {
+                ContactRecord<2> rec;
+                rec.i = static_cast<std::uint32_t>(i);
+                rec.wall = (*s.walls)[h.wall].id;
+                rec.normal = cf.normal;
+                rec.fn = cf.normal * cf.fn;
+                rec.ft = cf.ft;
+                rec.position = xi;
+                rec.point = c.point;
+                rec.branch = xi - c.point;
+                rec.overlap = c.overlap;
+                sink->push_back(rec);
+            }
             slot[q] = c;
         }
         s.count[i] = static_cast<std::uint8_t>(nh);

@@ -82,6 +82,8 @@ public:
     /// The measurements' hooks (run/measures.hpp): the contacts of the force pass at time t into *sink, the time of
     /// the last pass that recorded them (-1: none), every event-driven collision.
     virtual void recordContactsAt(ContactSink<D>*, double) {}
+    /// The contacts of the state at the start into *sink (TdmEngine::recordStartContacts): whether it could.
+    virtual bool recordStartContacts(ContactSink<D>*) { return false; }
     virtual double contactsRecordedAt() const { return -1; }
     virtual void setCollisionHook(std::function<void(const EdmCollision<D>&)>) {}
     /// The World's particles (in place, same count) or gravity were changed from outside, at world.time after
@@ -138,6 +140,7 @@ public:
     void saveState(ByteWriter& out) const override { eng_.saveState(out); }
     void loadState(const CheckpointFile& f) override { loadEngineState(f, w_, eng_); }
     void recordContactsAt(ContactSink<D>* s, double t) override { eng_.recordContactsAt(s, t); }
+    bool recordStartContacts(ContactSink<D>* s) override { return eng_.recordStartContacts(s); }
     double contactsRecordedAt() const override { return eng_.contactsRecordedAt(); }
 
 private:
@@ -257,6 +260,7 @@ public:
     void remove(const std::vector<std::uint32_t>& which) override { eng_.removeParticles(which); }
     void added(std::size_t first) override { eng_.addParticles(first); }
     void recordContactsAt(ContactSink<D>* s, double t) override { eng_.recordContactsAt(s, t); }
+    bool recordStartContacts(ContactSink<D>* s) override { return eng_.recordStartContacts(s); }
     double contactsRecordedAt() const override { return eng_.tdm().contactsRecordedAt(); }
     void setCollisionHook(std::function<void(const EdmCollision<D>&)> f) override {
         eng_.setCollisionHook(std::move(f));

@@ -32,13 +32,15 @@ double particleVolume(const Particles<D>& p, std::size_t i) {
     }
 }
 
-/// A box's grid spec: along a periodic axis that it spans the kernel wraps.
+/// A box's grid spec: along a periodic axis that it spans the kernel wraps; one that it covers in part sees the
+/// particles' and branches' periodic images that reach into it.
 template <int D>
 void boxOf(CgGridSpec<D>& s, const Domain<D>& dom, const Vec3d& lo, const Vec3d& hi) {
     for (int k = 0; k < D; ++k) {
         s.lo[k] = lo[k];
         s.hi[k] = hi[k];
         s.wraps[k] = dom.periodic[k] && lo[k] <= dom.lo[k] && hi[k] >= dom.hi[k];
+        s.period[k] = dom.periodic[k] && !s.wraps[k] ? dom.hi[k] - dom.lo[k] : 0.0;
     }
 }
 

@@ -87,6 +87,8 @@ public:
         measures_.emplace(sc_, world, dir_, plan_.snapshotPeriod);
         for (auto& c : measures_->columns()) columns.push_back(c);
         eng_->setCollisionHook([this](const EdmCollision<D>& c) { measures_->collision(c); });
+        // The outputs at the start time have their contacts too (a resumed run wrote those before its checkpoint).
+        if (!resume_ && measures_->wantsContacts()) eng_->recordStartContacts(measures_->sink());
         lastRowTime_ = world.time;
         // A resumed run's series.csv as the stopped run left it, read before it is rewritten.
         const bool resumeDir = resume_ && !startFrom;

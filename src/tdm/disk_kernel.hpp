@@ -501,6 +501,22 @@ double diskPairEnergy(const ForceContext<D>& ctx, std::size_t i, std::uint32_t k
     return Normal::energy(ctx.cs.pair(p.material[i], p.material[j]), delta, meff, p.radius[i] * p.radius[j] / rs);
 }
 
+/// The contact network's record of a disk pair from the law's parts (DiskKernel::record; the disks among polygons).
+template <int D>
+void pairRecord(const PairInputs<D>& in, std::size_t i, std::uint32_t j, const LawParts<D>& parts,
+                ContactRecord<D>& rec) {
+    rec.i = static_cast<std::uint32_t>(i);
+    rec.j = j;
+    rec.wall = -1;
+    rec.normal = storedVec(parts.normal);
+    rec.fn = storedVec(parts.fn);
+    rec.ft = storedVec(parts.ft);
+    rec.branch = storedVec(parts.d);
+    rec.overlap = parts.delta;
+    rec.position = in.x[i];
+    rec.point = in.x[i] - rec.normal * (in.radius[i] - 0.5 * parts.delta);
+}
+
 /// The kernel of the pair pass for disks and spheres (tdm/pair_pass.hpp has the interface): every pair by the
 /// particles' law, four at a time in lanes (kLanes) or one by one; same bits either way. Its walls: DiskWall.
 template <int D, class Normal, class Tangential, bool kLanes = kLanePairs>
@@ -555,16 +571,7 @@ public:
         e.a.c[3] = vir;
         storeRow<A>(e.b.c, pf.nxft);
         e.b.c[3] = overlap;
-        rec.i = static_cast<std::uint32_t>(i);
-        rec.j = j;
-        rec.wall = -1;
-        rec.normal = storedVec(parts.normal);
-        rec.fn = storedVec(parts.fn);
-        rec.ft = storedVec(parts.ft);
-        rec.branch = storedVec(parts.d);
-        rec.overlap = parts.delta;
-        rec.position = in_.x[i];
-        rec.point = in_.x[i] - rec.normal * (in_.radius[i] - 0.5 * parts.delta);
+        pairRecord(in_, i, j, parts, rec);
         return true;
     }
 

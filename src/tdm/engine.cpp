@@ -223,6 +223,7 @@ std::size_t TdmEngine<D>::wallContacts() const {
 
 template <int D>
 void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
+    pristine_ = false;
     Particles<D>& p = w_.particles;
     const std::size_t n = p.tdmCount();
     if (from.size() != n) throw std::invalid_argument("TdmEngine::remap: map size differs from tdmCount()");
@@ -262,6 +263,7 @@ void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
 
 template <int D>
 void TdmEngine<D>::restart() {
+    pristine_ = false;
     // The constructor's sequence, without its sort (the particles keep their places) and its walls' move (the
     // walls are at the current time already).
     rebuild(false);
@@ -301,6 +303,7 @@ void TdmEngine<D>::step() {
 
 template <int D>
 void TdmEngine<D>::finishStep(bool moved, std::atomic<bool>* nextMoved) {
+    pristine_ = false;
     // The k-th step ends at t0 + k dt exactly: outputs at k x period and moving walls see no drift of summed dt.
     ++steps_;
     w_.time = timeAfter(0);
@@ -313,17 +316,33 @@ void TdmEngine<D>::finishStep(bool moved, std::atomic<bool>* nextMoved) {
     if (recordSink_ && std::abs(w_.time - recordTime_) < 0.5 * s_.dt) [[unlikely]]
         recordNow_ = recordSink_;
     computeForces(true, nextMoved);
-    if (recordNow_) {
-        // Ids now: a hybrid may reorder its particles before the records are read.
-        const Particles<D>& p = w_.particles;
-        for (ContactRecord<D>& r : *recordNow_) {
-            r.idI = p.id[r.i];
-            r.idJ = r.j == ContactRecord<D>::kWall ? 0 : p.id[r.j];
-        }
-        recordedAt_ = w_.time;
-        recordNow_ = nullptr;
-    }
+    if (recordNow_) recorded();
     checkHealth();
+}
+
+template <int D>
+void TdmEngine<D>::recorded() {
+    // Ids now: a hybrid may reorder its particles before the records are read.
+    const Particles<D>& p = w_.particles;
+    for (ContactRecord<D>& r : *recordNow_) {
+        r.idI = p.id[r.i];
+        r.idJ = r.j == ContactRecord<D>::kWall ? 0 : p.id[r.j];
+    }
+    recordedAt_ = w_.time;
+    recordNow_ = nullptr;
+}
+
+template <int D>
+bool TdmEngine<D>::recordStartContacts(ContactSink<D>* sink) {
+    if (!pristine_ || !sink) return false;
+    // The springs before the constructor's pass: a new pair list's, no wall contact yet.
+    std::fill(pairs_.history.begin(), pairs_.history.end(), Vec<D>::zero());
+    std::fill(wallHistory_.begin(), wallHistory_.end(), Vec<D>::zero());
+    std::fill(surf_.count.begin(), surf_.count.end(), std::uint8_t{0});
+    recordNow_ = sink;
+    computeForces(false);
+    recorded();
+    return true;
 }
 
 template <int D>

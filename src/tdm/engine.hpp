@@ -67,13 +67,18 @@ public:
     void contactCounts(std::vector<std::uint8_t>& out) const;
 
     /// The contact network: the force pass of the step that ends at time t (to within half a step) puts every
-    /// contact it evaluates into *sink (tdm/contact_record.hpp); null: none. Not for scenes with polygons.
+    /// contact it evaluates into *sink (tdm/contact_record.hpp); null: none.
     void recordContactsAt(ContactSink<D>* sink, double t) {
         recordSink_ = sink;
         recordTime_ = t;
     }
     /// The time of the last force pass that recorded its contacts [s] (-1: none yet).
     double contactsRecordedAt() const { return recordedAt_; }
+    /// The contact network of the state at construction (an output at the start time): the constructor's force
+    /// pass again, recorded into *sink, from the springs as they were before it (none: every contact of a new engine
+    /// is new), so the same forces and springs bit for bit. False, and nothing done, once a step, a remap, a restart
+    /// or a checkpoint's state came after the constructor.
+    bool recordStartContacts(ContactSink<D>* sink);
 
     /// Elastic energy stored in contacts (pairs and walls) [J].
     double contactEnergy() const;
@@ -119,6 +124,8 @@ private:
     /// same particle).
     void buildCandidates(const std::uint32_t* from, double margin);
     void checkHealth() const;
+    /// After a pass that recorded its contacts: their ids, the time.
+    void recorded();
     /// Throws SimulationError when a particle moves more than its radius in one step.
     void checkSpeeds() const;
     /// The state a force pass reads and writes (sv, sw: the step's mean velocities).
@@ -143,6 +150,7 @@ private:
     ContactSink<D>* recordSink_ = nullptr;  ///< recordContactsAt
     ContactSink<D>* recordNow_ = nullptr;   ///< the sink, during the force pass that records
     double recordTime_ = 0, recordedAt_ = -1;
+    bool pristine_ = true;  ///< nothing since the constructor's force pass (recordStartContacts)
 };
 
 }  // namespace haet

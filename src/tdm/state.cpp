@@ -74,6 +74,7 @@ void TdmEngine<D>::saveState(ByteWriter& out) const {
 
 template <int D>
 void TdmEngine<D>::loadState(ByteReader& in) {
+    pristine_ = false;
     const std::size_t n = w_.particles.tdmCount();
     const auto saved = in.get<std::uint64_t>();
     if (saved != n)

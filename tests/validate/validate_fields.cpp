@@ -1,8 +1,8 @@
 // Chute flow in steady state (examples/chute3d_profiles.toml; docs/physics.md L.8): once the kinetic energy has
-// levelled off, the coarse-grained stress balances the weight above, sigma_zz(z) = int_z^H rho g cos(theta) and
-// -sigma_xz(z) = int_z^H rho g sin(theta) (compressive stress positive: the shear stress on the z faces points up
-// the slope) within 2 % in the bulk, and the velocity follows Bagnold's profile, v_x linear in
-// H^{3/2} - (H - z)^{3/2} within 5 % (Silbert et al. 2001).
+// levelled off (its drift over the averaging window below 10 %), the coarse-grained stress balances the weight above,
+// sigma_zz(z) = int_z^H rho g cos(theta) and -sigma_xz(z) = int_z^H rho g sin(theta) (compressive stress positive: the
+// shear stress on the z faces points up the slope) within 2 % in the bulk, and the velocity follows Bagnold's profile,
+// v_x linear in H^{3/2} - (H - z)^{3/2} within 5 % (Silbert et al. 2001).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -31,22 +31,27 @@ TEST(FieldsValidate, ChuteMomentumBalanceAndBagnoldProfile) {
     const double theta = std::atan2(sc.domain.gravity[0], -sc.domain.gravity[2]);
     const double g = std::hypot(sc.domain.gravity[0], sc.domain.gravity[2]);
 
-    // Steady state: the kinetic energy of the last 200 time units within 2 % of the 200 before.
+    // Steady state over the averaging window [t - window, t] of the last output: the kinetic energy's drift, the
+    // slope of its least-squares line times the window over its mean, below 10 %. Why that suffices: an
+    // acceleration dv/dt of the layer leaves sigma_xz short of the weight by (dv/dt) / (g sin theta); a drift
+    // dK/K = 2 dv/v over the window T is dv/dt = v dK/K / (2 T), here (v about 2, T = 200, g sin theta = 0.41) a
+    // mismatch of 0.012 dK/K: 0.12 % at the bound, small beside the 2 % checked.
     const testing::CsvTable s = testing::readCsv(o.outDir / "series.csv");
     const std::vector<double> t = s.column("time"), ke = s.column("kinetic_energy");
-    auto meanOver = [&](double t0, double t1) {
-        double sum = 0;
-        int n = 0;
-        for (std::size_t r = 0; r < t.size(); ++r)
-            if (t[r] >= t0 && t[r] < t1) sum += ke[r], ++n;
-        return sum / std::max(n, 1);
-    };
-    const double end = t.back(), late = meanOver(end - 200, end + 1), before = meanOver(end - 400, end - 200);
-    std::printf("kinetic energy: %.6g over the last 200, %.6g over the 200 before (%.2f %%)\n", late, before,
-                100 * (late / before - 1));
-    ASSERT_NEAR(late, before, 0.02 * before) << "not steady: the momentum balance holds only in steady flow";
+    const double end = t.back(), window = sc.fields.at(0).window;
+    double st = 0, sk = 0, n0 = 0;
+    for (std::size_t r = 0; r < t.size(); ++r)
+        if (t[r] >= end - window - 1e-9) st += t[r], sk += ke[r], ++n0;
+    const double tm = st / n0, km = sk / n0;
+    double stt = 0, stk = 0;
+    for (std::size_t r = 0; r < t.size(); ++r)
+        if (t[r] >= end - window - 1e-9) stt += (t[r] - tm) * (t[r] - tm), stk += (t[r] - tm) * (ke[r] - km);
+    const double drift = stk / stt * window / km;
+    std::printf("kinetic energy over the window [%.0f, %.0f]: mean %.6g, drift %.2f %% (%g rows)\n", end - window, end,
+                km, 100 * drift, n0);
+    ASSERT_LT(std::abs(drift), 0.10) << "not steady: the momentum balance holds only in steady flow";
 
-    // The last output's profiles (a window of 50 time units).
+    // The last output's profiles (the average over its window).
     const testing::CsvTable f = testing::readCsv(o.outDir / "fields_z.csv");
     const std::vector<double> time = f.column("time"), z = f.column("z"), rho = f.column("density"),
                               phi = f.column("volume_fraction"), vx = f.column("velocity_x"),
