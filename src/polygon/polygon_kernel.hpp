@@ -274,16 +274,10 @@ private:
         if (rec) [[unlikely]] {
             // The force point projected onto the wall: the branch ends on its surface, as a disk's does.
             const V2 at = x_[i] + cf.point;
-            rec->i = static_cast<std::uint32_t>(i);
-            rec->j = ContactRecord<2>::kWall;
-            rec->wall = wall.id;
-            rec->normal = wall.normal;
+            placeWallRecord(*rec, i, wall.id, x_[i], at - wall.normal * wall.distanceNow(at), wall.normal,
+                            clen > 0 ? o.area / clen : ri);
             rec->fn = cf.normal * cf.fn;
             rec->ft = cf.ft;
-            rec->overlap = clen > 0 ? o.area / clen : ri;
-            rec->position = x_[i];
-            rec->point = at - wall.normal * wall.distanceNow(at);
-            rec->branch = x_[i] - rec->point;
         }
         return true;
     }

@@ -173,15 +173,9 @@ public:
             worst = std::max(worst, c.overlap / ri);
             if (sink) [[unlikely]] {
                 ContactRecord<2> rec;
-                rec.i = static_cast<std::uint32_t>(i);
-                rec.wall = (*s.walls)[h.wall].id;
-                rec.normal = cf.normal;
+                placeWallRecord(rec, i, (*s.walls)[h.wall].id, xi, c.point, cf.normal, c.overlap);
                 rec.fn = cf.normal * cf.fn;
                 rec.ft = cf.ft;
-                rec.position = xi;
-                rec.point = c.point;
-                rec.branch = xi - c.point;
-                rec.overlap = c.overlap;
                 sink->push_back(rec);
             }
             slot[q] = c;

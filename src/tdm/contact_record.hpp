@@ -2,6 +2,7 @@
 // One contact as the force pass saw it (the contact network, docs/scenario.md "Contacts"; the contact stress of the
 // field grids, docs/physics.md L.3). The pair pass fills them only when ForceContext::contacts is set
 // (tdm/pair_pass.hpp): an ordinary step pays one null-pointer test.
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -27,5 +28,20 @@ struct ContactRecord {
 /// Where a force pass puts its contacts, in the pass's order (particle by particle: pairs, then walls).
 template <int D>
 using ContactSink = std::vector<ContactRecord<D>>;
+
+/// The geometry of a wall contact's record, as every kernel of walls of any shape fills it: the contact point on
+/// the wall's surface, the branch from it to the centre. The forces (fn, ft) are the caller's, from its law.
+template <int D>
+void placeWallRecord(ContactRecord<D>& rec, std::size_t i, std::int32_t wall, const Vec<D>& x, const Vec<D>& point,
+                     const Vec<D>& normal, double overlap) {
+    rec.i = static_cast<std::uint32_t>(i);
+    rec.j = ContactRecord<D>::kWall;
+    rec.wall = wall;
+    rec.normal = normal;
+    rec.position = x;
+    rec.point = point;
+    rec.branch = x - point;
+    rec.overlap = overlap;
+}
 
 }  // namespace haet

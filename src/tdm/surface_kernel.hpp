@@ -141,13 +141,7 @@ public:
                 s.poses[c.wall].surfaceVelocity(c.point), v_[i], w_[i], sv_[i], sw_[i], ri, mass_[i], clip_, c.spring,
                 dt_, f, tq, sink ? &rec.fn : nullptr, sink ? &rec.ft : nullptr);
             if (sink) [[unlikely]] {
-                rec.i = static_cast<std::uint32_t>(i);
-                rec.wall = wall.id;
-                rec.normal = c.normal;
-                rec.position = xi;
-                rec.point = c.point;
-                rec.branch = xi - c.point;
-                rec.overlap = c.overlap;
+                placeWallRecord(rec, i, wall.id, xi, c.point, c.normal, c.overlap);
                 sink->push_back(rec);
             }
             worst = std::max(worst, c.overlap / ri);
