@@ -45,6 +45,23 @@ struct SurfaceHit {
     double distance;  ///< |centre - point| [m]
 };
 
+/// A box in a wall's body frame [m].
+template <int D>
+struct ElementBox {
+    Vec<D> lo, hi;
+};
+
+/// The squared distance from x to box b (0 inside it) [m^2].
+template <int D>
+double boxDistance2(const ElementBox<D>& b, const Vec<D>& x) {
+    double d2 = 0;
+    for (int a = 0; a < D; ++a) {
+        const double d = std::max(b.lo[a] - x[a], 0.0) + std::max(x[a] - b.hi[a], 0.0);
+        d2 += d * d;
+    }
+    return d2;
+}
+
 template <int D>
 struct SurfaceWall {
     std::string name;  ///< for outputs; may be empty
@@ -99,6 +116,18 @@ struct SurfaceWall {
         }
         lo = centre - Vec<D>::filled(radius);
         hi = centre + Vec<D>::filled(radius);
+    }
+    /// The body-frame box of element e widened by 1e-9 of its size and distance from the origin, so that a closest
+    /// point as computed, rounded, never lies outside it: an element whose padded box lies beyond a distance cannot
+    /// come closer than that, and its closest point need not be found.
+    ElementBox<D> paddedBox(std::size_t e) const {
+        ElementBox<D> b;
+        bounds(e, b.lo, b.hi);
+        double size = 0;
+        for (int a = 0; a < D; ++a) size = std::max({size, b.hi[a] - b.lo[a], std::abs(b.lo[a]), std::abs(b.hi[a])});
+        b.lo -= Vec<D>::filled(1e-9 * size);
+        b.hi += Vec<D>::filled(1e-9 * size);
+        return b;
     }
     /// The largest distance of a point of the wall from `c` [m] (how far a rotation about c moves it).
     double reachFrom(const Vec<D>& c) const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "neighbor/cell_grid.hpp"
 
@@ -107,15 +108,24 @@ void buildSurfaceCandidates(const Particles<D>& p, std::size_t n, const Domain<D
     for (std::size_t c = 1; c < cellCount.size(); ++c) cellCount[c] += cellCount[c - 1];
     std::vector<std::uint32_t> at(cellCount.begin(), cellCount.end() - 1);
     std::vector<std::uint32_t> cellWall(binned.size()), cellElement(binned.size());
+    // Mesh elements with their padded body-frame boxes: a particle's test of an element starts with the distance
+    // to its box, a few instructions, and most are ruled out before their closest points are found (the same
+    // candidates: the closest point lies inside the box). Other shapes have an infinite box: always tested.
+    ElementBox<D> always;
+    always.lo = Vec<D>::filled(-std::numeric_limits<double>::infinity());
+    always.hi = Vec<D>::filled(std::numeric_limits<double>::infinity());
+    std::vector<ElementBox<D>> cellBox(binned.size(), always);
     for (const Binned& b : binned) {  // stable: each cell keeps wall then element order
         const std::uint32_t q = at[b.cell]++;
         cellWall[q] = b.wall;
         cellElement[q] = b.element;
+        if (walls[b.wall].kind == SurfaceKind::Mesh) cellBox[q] = walls[b.wall].paddedBox(b.element);
     }
 
     for (std::size_t i = 0; i < n; ++i) {
         const auto cell = static_cast<std::uint32_t>(grid.cellOf(p.x[i]));
         const double r = p.radius[i] + skin;
+        const double beyond2 = r * r * (1 + 1e-9);
         std::uint32_t lastWall = 0xFFFFFFFFu;
         Vec<D> xb;
         for (std::uint32_t q = cellCount[cell]; q < cellCount[cell + 1]; ++q) {
@@ -124,6 +134,7 @@ void buildSurfaceCandidates(const Particles<D>& p, std::size_t n, const Domain<D
                 xb = poses[w].toBody(p.x[i]);
                 lastWall = w;
             }
+            if (boxDistance2(cellBox[q], xb) > beyond2) continue;
             if (walls[w].distance(cellElement[q], xb) <= r) {
                 out.wall.push_back(w);
                 out.element.push_back(cellElement[q]);

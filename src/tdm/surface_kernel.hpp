@@ -36,6 +36,7 @@ public:
 
     explicit SurfaceKernel(const ForceContext<D>& ctx)
         : s_(ctx.surfaces),
+          slotOf_(ctx.surfaces ? ctx.surfaces->slotOf.data() : nullptr),
           x_(ctx.p.x.data()),
           v_(ctx.p.v.data()),
           w_(ctx.p.w.data()),
@@ -52,10 +53,34 @@ public:
     /// Adds particle i's contacts with walls of any shape to its force f and torque tq, and their overlap / radius to
     /// worst; returns how many touch.
     /// With sink (the contact network's pass) also each contact as the law computed it.
-    std::uint32_t add(std::size_t i, Vec<D>& f, Ang<D>& tq, double& worst, ContactSink<D>* sink = nullptr) const {
-        SurfaceState<D>& s = *s_;
+    /// Most particles of a scene have no wall element near them: their test is inlined into the pass, and only the
+    /// others pay for the call.
+    [[gnu::always_inline]] std::uint32_t add(std::size_t i, Vec<D>& f, Ang<D>& tq, double& worst,
+                                             ContactSink<D>* sink = nullptr) const {
+        const std::uint32_t base = slotOf_[i];
+        if (base == SurfaceState<D>::kNoSlots) return 0;
+        return addNear(i, base, f, tq, worst, sink);
+    }
+
+    /// The elastic energy of particle i's contacts with walls of any shape at the last force pass [J].
+    double energy(std::size_t i) const {
+        const SurfaceState<D>& s = *s_;
         const std::uint32_t base = s.slotOf[i];
         if (base == SurfaceState<D>::kNoSlots) return 0;
+        double e = 0;
+        for (int q = 0; q < s.count[i]; ++q) {
+            const SurfaceContact<D>& c = s.slots[base + q];
+            e += Normal::energy(table_[material_[i] * nMaterials_ + (*s.walls)[c.wall].material], c.overlap, mass_[i],
+                                radius_[i]);
+        }
+        return e;
+    }
+
+private:
+    /// add() of particle i, whose contacts take the slots from base on.
+    [[gnu::noinline]] std::uint32_t addNear(std::size_t i, std::uint32_t base, Vec<D>& f, Ang<D>& tq, double& worst,
+                                            ContactSink<D>* sink) const {
+        SurfaceState<D>& s = *s_;
         const std::vector<SurfaceWall<D>>& walls = *s.walls;
         const double ri = radius_[i];
         const Vec<D> xi = x_[i];
@@ -151,32 +176,8 @@ public:
         return static_cast<std::uint32_t>(nh);
     }
 
-    /// The elastic energy of particle i's contacts with walls of any shape at the last force pass [J].
-    double energy(std::size_t i) const {
-        const SurfaceState<D>& s = *s_;
-        const std::uint32_t base = s.slotOf[i];
-        if (base == SurfaceState<D>::kNoSlots) return 0;
-        double e = 0;
-        for (int q = 0; q < s.count[i]; ++q) {
-            const SurfaceContact<D>& c = s.slots[base + q];
-            e += Normal::energy(table_[material_[i] * nMaterials_ + (*s.walls)[c.wall].material], c.overlap, mass_[i],
-                                radius_[i]);
-        }
-        return e;
-    }
-
-private:
-    /// The squared distance from x to box b (0 inside it) [m^2].
-    static double boxDistance2(const ElementBox<D>& b, const Vec<D>& x) {
-        double d2 = 0;
-        for (int a = 0; a < D; ++a) {
-            const double d = std::max(b.lo[a] - x[a], 0.0) + std::max(x[a] - b.hi[a], 0.0);
-            d2 += d * d;
-        }
-        return d2;
-    }
-
     SurfaceState<D>* s_;
+    const std::uint32_t* slotOf_;  ///< SurfaceState::slotOf (its size is fixed during a pass)
     const Vec<D>* x_;
     const Vec<D>* v_;
     const Ang<D>* w_;

@@ -29,12 +29,6 @@ struct SurfaceContact {
     std::uint32_t wall = 0;  ///< index into the surface walls
 };
 
-/// An element's box in its wall's body frame [m].
-template <int D>
-struct ElementBox {
-    Vec<D> lo, hi;
-};
-
 template <int D>
 struct SurfaceState {
     static constexpr std::uint32_t kNoSlots = 0xFFFFFFFFu;
@@ -49,8 +43,7 @@ struct SurfaceState {
     std::vector<SurfaceContact<D>> slots;
     /// The body-frame boxes of the mesh walls' elements, wall w's at boxes[boxFirst[w] + e] (none for other shapes):
     /// the force pass skips a candidate whose box lies beyond the particle's radius before finding its closest
-    /// point. Each box is widened by 1e-9 of its size and distance from the origin, so that a closest point as
-    /// computed, rounded, never lies outside it: a skipped element could not have touched.
+    /// point (SurfaceWall::paddedBox: a skipped element could not have touched).
     std::vector<std::uint32_t> boxFirst;
     std::vector<ElementBox<D>> boxes;
 
@@ -66,16 +59,7 @@ struct SurfaceState {
             // A wall's shape is fixed in its body frame: how far a rotation can move its points is known once.
             reach.push_back(wall.reachFrom(wall.motion.centre));
             if (wall.kind == SurfaceKind::Mesh)
-                for (std::size_t e = 0; e < wall.elementCount(); ++e) {
-                    ElementBox<D> b;
-                    wall.bounds(e, b.lo, b.hi);
-                    double size = 0;
-                    for (int a = 0; a < D; ++a)
-                        size = std::max({size, b.hi[a] - b.lo[a], std::abs(b.lo[a]), std::abs(b.hi[a])});
-                    b.lo -= Vec<D>::filled(1e-9 * size);
-                    b.hi += Vec<D>::filled(1e-9 * size);
-                    boxes.push_back(b);
-                }
+                for (std::size_t e = 0; e < wall.elementCount(); ++e) boxes.push_back(wall.paddedBox(e));
             boxFirst.push_back(static_cast<std::uint32_t>(boxes.size()));
         }
     }
