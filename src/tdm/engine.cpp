@@ -43,6 +43,7 @@ ForceContext<D> TdmEngine<D>::context(const Vec<D>* sv, const Ang<D>* sw) const 
     if (!planeForce_.empty()) ctx.planeForce = const_cast<Vec<D>*>(planeForce_.data());
     if (!surf_.empty()) ctx.surfaces = const_cast<SurfaceState<D>*>(&surf_);
     ctx.contacts = recordNow_;
+    if (!nearPlanes_.empty() && nearPlanes_.size() == w_.particles.tdmCount()) ctx.nearPlanes = nearPlanes_.data();
     return ctx;
 }
 
@@ -133,11 +134,50 @@ void TdmEngine<D>::rebuild(bool sort) {
     if (!surf_.empty())
         buildCandidates(sortOrder.empty() ? nullptr : sortOrder.data(),
                         staticSurfaces_ ? 0.5 * (1 + 1e-9) * s_.skin : s_.skin);
+    markNearPlanes();
+}
+
+template <int D>
+void TdmEngine<D>::markNearPlanes() {
+    nearPlanes_.clear();
+    planesAtMark_.clear();
+    const std::size_t nw = w_.walls.size();
+    if (nw == 0 || shapes_ || !s_.markPlanes) return;
+    for (const Wall<D>& wall : w_.walls)
+        if (!(wall.velocity == Vec<D>::zero()) || wall.oscillates()) return;
+    const Particles<D>& p = w_.particles;
+    const std::size_t n = p.tdmCount();
+    // The drift test rebuilds before any particle is more than skin/2 from xAtBuild_ (a hair more, for its
+    // rounding, as the candidates of walls of any shape).
+    const double margin = 0.5 * (1 + 1e-9) * s_.skin;
+    nearPlanes_.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        bool near = false;
+        for (const Wall<D>& wall : w_.walls) near = near || wall.distanceNow(xAtBuild_[i]) <= p.radius[i] + margin;
+        if (near) {
+            nearPlanes_[i] = 1;
+            continue;
+        }
+        for (std::size_t q = 0; q < nw; ++q) {
+            wallHistory_[i * nw + q] = Vec<D>::zero();
+            if (!planeForce_.empty()) planeForce_[i * nw + q] = Vec<D>::zero();
+        }
+    }
+    for (const Wall<D>& wall : w_.walls) {
+        planesAtMark_.push_back(wall.pointNow);
+        planesAtMark_.push_back(wall.normal);
+    }
 }
 
 template <int D>
 void TdmEngine<D>::moveWalls() {
     for (Wall<D>& wall : w_.walls) wall.moveTo(w_.time);
+    // A plane changed from outside since the marks (a script, say): every particle tests the planes again.
+    for (std::size_t q = 0; q < w_.walls.size() && !planesAtMark_.empty(); ++q)
+        if (!(w_.walls[q].pointNow == planesAtMark_[2 * q]) || !(w_.walls[q].normal == planesAtMark_[2 * q + 1])) {
+            nearPlanes_.clear();
+            planesAtMark_.clear();
+        }
     if (surf_.empty()) return;
     const auto& walls = w_.surfaces;
     surf_.poses.resize(walls.size());
@@ -259,6 +299,7 @@ void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
     remapPairList(p, w_.domain, NeighborSettings{s_.skin, true}, from, pairs_, xAtBuild_.data());
     if (s_.planeLoads) planeForce_.assign(n * nw, Vec<D>::zero());
     if (!surf_.empty()) buildCandidates(from.data(), s_.skin);  // kept particles drifted from xAtBuild_ already
+    markNearPlanes();
 }
 
 template <int D>

@@ -26,6 +26,9 @@ struct TdmSettings {
     double maxOverlap = 0.5;  ///< blow-up limit: overlap / smaller radius [-]
     int sortEvery = 1000;     ///< spatial re-sort period in steps (0 = never)
     bool planeLoads = false;  ///< keep each plane contact's force, for the planes' loads (planeLoad)
+    /// Particles far from every static plane skip the planes until the next build (markNearPlanes); false: every
+    /// particle tests every plane, the twin the marks are tested against (the same bits).
+    bool markPlanes = true;
     /// Set from outside (a signal handler: run/stop.hpp) to end advanceTo after the step under way; null: never.
     const std::atomic<bool>* stop = nullptr;
 };
@@ -98,6 +101,8 @@ public:
     std::size_t wallContacts() const;
     /// The walls of any shape as the last force pass saw them: poses, candidates, contacts (for tests).
     const SurfaceState<D>& surfaceState() const { return surf_; }
+    /// Per particle whether it tests the planes until the next build (markNearPlanes); empty: all do (for tests).
+    const std::vector<std::uint8_t>& nearPlanes() const { return nearPlanes_; }
 
     /// What the engine keeps beyond the World, for a checkpoint (tdm/state.cpp): the pair list with its springs, the
     /// planes' springs, the contacts with walls of any shape and their candidates, the integrator's history, the
@@ -123,6 +128,10 @@ private:
     /// margin [m]; the contacts of new particle k are those of old particle from[k] (kFresh: none; from null: the
     /// same particle).
     void buildCandidates(const std::uint32_t* from, double margin);
+    /// nearPlanes_ from the positions at the last build (xAtBuild_): a particle is near when some plane lies
+    /// within its radius plus half the skin, the farthest it moves before the next build; the springs and forces
+    /// of the others' planes are cleared (they do not touch). None when a plane moves, or with polygons.
+    void markNearPlanes();
     void checkHealth() const;
     /// After a pass that recorded its contacts: their ids, the time.
     void recorded();
@@ -143,6 +152,8 @@ private:
     SurfaceState<D> surf_;
     bool staticSurfaces_ = true;  ///< no wall of any shape moves: candidates with the pair list reach skin/2 (rebuild)
     std::vector<Vec<D>> xAtBuild_;
+    std::vector<std::uint8_t> nearPlanes_;  ///< markNearPlanes; empty: every particle tests every plane
+    std::vector<Vec<D>> planesAtMark_;      ///< the planes' points and normals then (a plane moved since: unmarked)
     ForceStats stats_;
     std::unique_ptr<ShapePass> shapes_;  ///< 2D scenes with polygons: their force pass
     std::uint64_t steps_ = 0, rebuilds_ = 0, lastSort_ = 0;

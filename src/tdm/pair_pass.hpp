@@ -78,6 +78,9 @@ struct ForceContext {
     /// null, or where the pass puts every contact it evaluates (the contact network; the pass then runs on one
     /// thread through the kernel's record(), the same bits as its blocks: recordingPass)
     ContactSink<D>* contacts = nullptr;
+    /// null, or per particle whether it may touch a plane (0: it cannot before the next pair-list build, and its
+    /// plane springs and forces are zero: the planes are skipped, which adds nothing, as their test would)
+    const std::uint8_t* nearPlanes = nullptr;
 };
 
 template <int D>
@@ -128,6 +131,7 @@ struct FinishViews {
     Ang<D>* torque;
     const Vec<D>* x;
     const std::uint8_t* flags;
+    const std::uint8_t* nearPlanes;
     std::size_t nWalls;
     bool surfaces;
     explicit FinishViews(const ForceContext<D>& ctx)
@@ -135,12 +139,13 @@ struct FinishViews {
           torque(ctx.p.torque.data()),
           x(ctx.p.x.data()),
           flags(ctx.p.flags.data()),
+          nearPlanes(ctx.nearPlanes),
           nWalls(ctx.nWalls),
           surfaces(ctx.surfaces != nullptr) {}
 };
 
-/// Particle i's pair sums are complete: adds its wall contacts (planes in wall order, then the walls of any shape;
-/// not for a frozen particle), stores
+/// Particle i's pair sums are complete: adds its wall contacts (planes in wall order, unless it is far from them all,
+/// then the walls of any shape; not for a frozen particle), stores
 /// force and torque, then runs the caller's per-particle step then(i, f, torque).
 template <int D, class K, class Then>
 [[gnu::always_inline]] inline ParticleTally finishParticle(const FinishViews<D>& fv, const K& kernel, std::size_t i,
@@ -151,7 +156,8 @@ template <int D, class K, class Then>
     const KernelVec<D> xi = kernelVec(fv.x[i]);
     // A NaN anywhere reaches the force of its particle in the same step.
     bool finite;
-    const std::size_t nw = fv.nWalls;
+    // A particle far from every plane skips them (ForceContext::nearPlanes): most of a deep bed.
+    const std::size_t nw = fv.nearPlanes && !fv.nearPlanes[i] ? 0 : fv.nWalls;
     if ((nw > 0 || fv.surfaces) && !(fv.flags[i] & kFrozen)) {
         Vec<D> f = storedVec(fk);
         Ang<D> tq = storedVec(tqk);

@@ -149,6 +149,10 @@ void TdmEngine<D>::loadState(ByteReader& in) {
     // list made again on first use.
     moveWalls();
     pairs_.dropDerived();
+    // Every particle tests the planes until the next build marks them again (the same forces: a far particle's
+    // plane springs are zero either way).
+    nearPlanes_.clear();
+    planesAtMark_.clear();
 }
 
 template void TdmEngine<2>::saveState(ByteWriter&) const;
