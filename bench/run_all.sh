@@ -16,6 +16,8 @@
 #                                           side in one run, with the polygon/disk cost ratio
 # 10. bench/python_step_loop.py             a Python loop of 10 000 sim.step(1) against sim.step(10000), 10 000
 #                                           disks (when the module is built: BUILD_DIR/python)
+# 11. bench/peers/edmd_smallenburg.sh       the event-driven engine against Smallenburg's EDMD (Single, Cell), 3D
+#                                           phi = 0.1, 0.3, 0.45, when EDMD_SOURCE names a checkout of it
 # The first run on a machine prepares the flowing states with LAMMPS (10-15 min for 3D, once; kept in
 # bench/data/) and LIGGGHTS (a few minutes), and the settled bed (about a minute). Installs the Debian packages
 # lammps, liggghts and time when missing. Exits non-zero when any part failed, after running the others.
@@ -95,6 +97,14 @@ if ls "$build"/python/haet*.so >/dev/null 2>&1; then
     echo
 else
     echo "=== Python: $build/python not built (make python); skipped"
+fi
+
+if [ -n "${EDMD_SOURCE:-}" ]; then
+    echo "=== event-driven gas: HAET vs Smallenburg's EDMD ($EDMD_SOURCE)"
+    "$here/peers/edmd_smallenburg.sh" "$EDMD_SOURCE" "$build" || failed="$failed peers_edmd"
+    echo
+else
+    echo "=== event-driven peers: EDMD_SOURCE not set (a checkout of https://github.com/FSmallenburg/EDMD); skipped"
 fi
 
 if [ -n "$failed" ]; then
