@@ -268,6 +268,7 @@ public:
     }
     void stateChanged() override { eng_->stateChanged(); }
     void added(std::size_t first) override { eng_->added(first); }
+    std::uint64_t takeIds(std::uint64_t n) override { return flow_->takeIds(n); }
     void remove(const std::vector<std::uint32_t>& which) override { eng_->remove(which); }
     void save(const std::filesystem::path& file) override {
         if (!checkpoints_)
