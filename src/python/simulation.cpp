@@ -241,6 +241,7 @@ Use it as a context manager, or call finish() and close().)");
                                "series.csv's rows so far: a dict of numpy arrays by column (NaN: empty cell)")
         .def_property_readonly("run_info", &runInfoOf, "run.json as last written (at the start, at finish())");
     bindParticles(c);
+    bindWalls(c);
 }
 
 }  // namespace haet::python
