@@ -60,6 +60,14 @@ def main():
             rows.append((b + 1, kind, n, a.block, a.threads, f"{seconds:.5f}"))
     overhead = total["loop"] / total["single"] - 1
     per_call = (total["loop"] - total["single"]) / a.steps
+    # Each pair of neighbouring blocks holds one of each kind, timed within seconds of each other: their ratio is
+    # the loop's cost under the same load; the spread of the ratios shows how noisy the machine was.
+    ratios = []
+    for k in range(0, len(rows) - 1, 2):
+        by = {rows[k][1]: float(rows[k][5]), rows[k + 1][1]: float(rows[k + 1][5])}
+        ratios.append(by["loop"] / by["single"])
+    ratios.sort()
+    median = ratios[len(ratios) // 2] if len(ratios) % 2 else 0.5 * sum(ratios[len(ratios) // 2 - 1:][:2])
     with open(out, "w") as f:
         f.write("date,haet_commit,block,kind,particles,steps,threads,seconds\n")
         day, head = datetime.date.today().isoformat(), commit()
@@ -67,7 +75,8 @@ def main():
             f.write(",".join(str(v) for v in (day, head) + row) + "\n")
     print(f"{n} particles, {a.steps} steps of each kind in blocks of {a.block}: single calls {total['single']:.3f} s, "
           f"loop {total['loop']:.3f} s: overhead {100 * overhead:.2f} % ({1e6 * per_call:.1f} us per call; "
-          f"limit 5 %); {out}")
+          f"limit 5 %); loop/single per pair of blocks: min {ratios[0]:.4f}, median {median:.4f} "
+          f"({len(ratios)} pairs); {out}")
     return 0 if overhead <= 0.05 else 1
 
 

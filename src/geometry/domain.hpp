@@ -45,8 +45,8 @@ struct Domain {
 };
 
 /// An infinite plane wall, translating with a constant velocity and optionally oscillating about that motion
-/// (a vibrated floor, docs/physics.md H.1): point(t) = point + v t + A (sin(2 pi f t + phi) - sin phi). The normal
-/// points into the domain.
+/// (a vibrated floor, docs/physics.md H.1): point(t) = point + v s + A (sin(2 pi f s + phi) - sin phi), s = t - origin.
+/// The normal points into the domain. origin is 0 until the motion is changed during a run (setVelocity).
 template <int D>
 struct Wall {
     Vec<D> point;     ///< a point of the plane at time 0 [m]
@@ -58,6 +58,8 @@ struct Wall {
     double phase = 0;      ///< oscillation phase phi [rad]
     std::string name;      ///< named walls report their load (series.csv); may be empty
     int id = 0;            ///< the wall's place among the scenario's walls, 0-based (outputs number walls by it)
+    double origin = 0;     ///< the time point, velocity and the oscillation count from [s]
+    bool changed = false;  ///< the motion was changed during the run (setVelocity): not the scenario's any more
     /// Where the plane is and how fast it moves at the time of the current force pass (moveTo).
     Vec<D> pointNow, velocityNow;
 
@@ -72,14 +74,27 @@ struct Wall {
         return w;
     }
     bool oscillates() const { return frequency != 0; }
+    // (t - origin is t itself while origin is 0: the same bits as the formula with t.)
     Vec<D> pointAt(double t) const {
-        Vec<D> p = point + velocity * t;
-        if (oscillates()) p += oscillationDisplacement(amplitude, frequency, phase, t);
+        const double s = t - origin;
+        Vec<D> p = point + velocity * s;
+        if (oscillates()) p += oscillationDisplacement(amplitude, frequency, phase, s);
         return p;
     }
     Vec<D> velocityAt(double t) const {
         if (!oscillates()) return velocity;
-        return velocity + oscillationVelocity(amplitude, frequency, phase, t);
+        return velocity + oscillationVelocity(amplitude, frequency, phase, t - origin);
+    }
+    /// From time t on, the plane translates with velocity v, from where it is at t (no jump); an oscillation goes on
+    /// in phase.
+    void setVelocity(const Vec<D>& v, double t) {
+        point = pointAt(t);
+        if (oscillates())
+            phase = std::remainder(phase + 2 * std::numbers::pi * frequency * (t - origin), 2 * std::numbers::pi);
+        origin = t;
+        velocity = v;
+        changed = true;
+        moveTo(t);
     }
     /// Sets pointNow and velocityNow to time t: once before every force pass, which reads only them.
     void moveTo(double t) {

@@ -6,6 +6,11 @@
 // with c the centre of rotation, R(t) the rotation by the angle omega t about the axis, so d(0) = 0 and x(0) = b.
 // The wall's material point at x moves with u(x, t) = v + 2 pi f A cos(2 pi f t + phi) + Omega x (x - c - d(t)),
 // Omega = omega times the unit axis (2D: the spin about z): the velocity a contact sees at its contact point.
+//
+// A motion changed during a run (Motion::rebase, from a script) counts from the time of the change, t0: the pose the
+// wall had then becomes its base B (body point b -> B b), and x(t) = c0 + d(t - t0) + R(t - t0) (B b - c0), with c0 the
+// centre of rotation at t0, so that the wall goes on from where it was. Until then the base is the identity, t0 = 0,
+// and the formulas above are computed as written (the same bits).
 #include <cmath>
 #include <numbers>
 
@@ -44,6 +49,17 @@ struct Rotation {
             x[i] = s;
         }
         return x;
+    }
+    /// The rotation `this` after `first`: (this first) b.
+    Rotation after(const Rotation& first) const {
+        Rotation r;
+        for (int i = 0; i < D; ++i)
+            for (int j = 0; j < D; ++j) {
+                double s = m[i][0] * first.m[0][j];
+                for (int k = 1; k < D; ++k) s += m[i][k] * first.m[k][j];
+                r.m[i][j] = s;
+            }
+        return r;
     }
     Vec<D> applyInverse(const Vec<D>& x) const {
         Vec<D> b;
@@ -99,6 +115,13 @@ struct Motion {
     Vec<D> centre;          ///< centre of rotation c at t = 0 [m]
     Ang<D> axis = unitZ();  ///< unit rotation axis (3D; 2D: z, the only one) [-]
     double omega = 0;       ///< angular speed about the axis [rad/s], counter-clockwise about it
+    /// The time the motion counts from [s]: 0, or the time of the last rebase.
+    double origin = 0;
+    /// The wall's pose at `origin` (body point b -> baseRot b + baseShift): the identity until a rebase.
+    Rotation<D> baseRot = Rotation<D>::identity();
+    Vec<D> baseShift;
+    bool rebased = false;      ///< rebased at least once: at() composes the base
+    bool baseRotated = false;  ///< baseRot is not the identity
 
     static Ang<D> unitZ() {
         Ang<D> z;
@@ -109,17 +132,20 @@ struct Motion {
     bool oscillates() const { return frequency != 0 && norm2(amplitude) > 0; }
     bool moves() const { return rotates() || oscillates() || norm2(velocity) > 0; }
 
+    // (t - origin is t itself until a rebase: the same bits as the formulas with t.)
     /// Translation d(t) of the body (the centre of rotation moves with it) [m].
     Vec<D> displacement(double t) const {
-        Vec<D> d = velocity * t;
-        if (oscillates()) d += oscillationDisplacement(amplitude, frequency, phase, t);
+        const double s = t - origin;
+        Vec<D> d = velocity * s;
+        if (oscillates()) d += oscillationDisplacement(amplitude, frequency, phase, s);
         return d;
     }
     Vec<D> translationVelocity(double t) const {
         if (!oscillates()) return velocity;
-        return velocity + oscillationVelocity(amplitude, frequency, phase, t);
+        return velocity + oscillationVelocity(amplitude, frequency, phase, t - origin);
     }
     Pose<D> at(double t) const {
+        if (rebased) return composedAt(t);
         Pose<D> p;
         const Vec<D> d = displacement(t);
         p.velocity = translationVelocity(t);
@@ -134,6 +160,20 @@ struct Motion {
         }
         return p;
     }
+    /// Makes the pose at time t the base and t the origin, so that a change of velocity, omega or axis made next
+    /// takes effect from t with the wall where it is (no jump); the oscillation goes on in phase.
+    void rebase(double t) {
+        const Pose<D> p = at(t);
+        if (oscillates())
+            phase = std::remainder(phase + 2 * std::numbers::pi * frequency * (t - origin), 2 * std::numbers::pi);
+        baseRot = p.rot;
+        baseShift = p.shift;
+        baseRotated = p.rotated;
+        origin = t;
+        rebased = true;
+    }
+    /// The centre of rotation at `origin` in the world [m] (centre itself until a rebase).
+    Vec<D> baseCentre() const { return rebased ? base(centre) : centre; }
     /// A bound on how far any point within `reach` [m] of the centre of rotation has moved between t0 and t1 [m]:
     /// the translation's path length bound plus the chord of the rotation.
     double maxDisplacement(double t0, double t1, double reach) const {
@@ -143,6 +183,29 @@ struct Motion {
             s += 2 * std::sin(0.5 * a) * reach;
         }
         return s;
+    }
+
+private:
+    Vec<D> base(const Vec<D>& b) const { return baseRotated ? baseRot.apply(b) + baseShift : b + baseShift; }
+    // x(t) = c0 + d + R (B b - c0) = (R B) b + (c0 + d + R (baseShift - c0)), B b = baseRot b + baseShift.
+    Pose<D> composedAt(double t) const {
+        Pose<D> p;
+        const Vec<D> d = displacement(t);
+        const Vec<D> c0 = base(centre);
+        p.velocity = translationVelocity(t);
+        p.centre = c0 + d;
+        if (rotates()) {
+            const Rotation<D> r = rotationOf<D>(axis, omega * (t - origin));
+            p.rotated = true;
+            p.rot = r.after(baseRot);
+            p.spin = axis * omega;
+            p.shift = c0 + d + r.apply(baseShift - c0);
+        } else {
+            p.rotated = baseRotated;
+            p.rot = baseRot;
+            p.shift = baseShift + d;
+        }
+        return p;
     }
 };
 

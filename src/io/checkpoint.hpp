@@ -26,7 +26,7 @@ static_assert(std::endian::native == std::endian::little, "the checkpoint format
 
 /// The format this program writes and the newest it reads. Raise it with every change of what any section holds;
 /// a reader of version k reads files of version k only (a state whose meaning changed cannot be carried over).
-inline constexpr std::uint32_t kCheckpointVersion = 2;
+inline constexpr std::uint32_t kCheckpointVersion = 3;
 inline constexpr std::string_view kCheckpointMagic = "HAETCKPT";
 
 /// What is wrong with a checkpoint, for the message and for whether an older one may serve instead.

@@ -174,8 +174,7 @@ void Simulation::addOf(py::array_t<double> positions, py::array_t<double> radii,
         throw std::invalid_argument("add_particles: velocities (N, " + std::to_string(D) + ")");
     for (py::ssize_t i = 0; i < n; ++i)
         if (!(r(i) > 0)) throw std::invalid_argument("add_particles: radii must be > 0");
-    std::uint64_t next = 0;
-    for (std::uint64_t id : p.id) next = std::max(next, id + 1);
+    std::uint64_t next = session().takeIds(static_cast<std::uint64_t>(n));
     const std::size_t first = p.size();
     const double density = sc_.materials[material].density;
     for (py::ssize_t i = 0; i < n; ++i) {
@@ -297,7 +296,7 @@ void bindParticles(py::class_<Simulation>& c) {
              py::arg("velocities") = py::none(), py::arg("material") = py::none(),
              "Adds spheres (disks in 2D) as an inlet does: positions (N, D) [m], radii (N,) [m], velocities "
              "(N, D) [m/s] (default: at rest), material: a name or index (default: the first); mass from its "
-             "density. Their ids follow the largest one.")
+             "density. Their ids come from the counter the inlets use: never one a particle of the run had.")
         .def("remove", &Simulation::remove, py::arg("ids"), "Removes the particles with these ids, as an outlet does.");
 }
 

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <optional>
 #include <system_error>
 
 #include "io/table.hpp"
@@ -184,7 +185,17 @@ Use it as a context manager, or call finish() and close().)");
         .def_static(
             "from_dict",
             [](const py::dict& d, const OptPath& out, int threads, const Sets& set) {
-                return make(parseScenario(tomlOfDict(d), "<dict>", set), out, threads);
+                const std::string toml = tomlOfDict(d);
+                std::optional<Scenario> sc;
+                try {
+                    sc = parseScenario(toml, "<dict>", set);
+                } catch (const ScenarioError& e) {
+                    // A line of the TOML text made from the dict would point nowhere the caller can see (an
+                    // override's error names the override instead, and stays as it is).
+                    if (e.pos().file != "<dict>") throw;
+                    throw ScenarioError({"<dict>", 0}, e.key(), e.message());
+                }
+                return make(*sc, out, threads);
             },
             py::arg("scenario"), py::kw_only(), py::arg("out") = py::none(), py::arg("threads") = 0,
             py::arg("set") = Sets{},
@@ -230,6 +241,7 @@ Use it as a context manager, or call finish() and close().)");
                                "series.csv's rows so far: a dict of numpy arrays by column (NaN: empty cell)")
         .def_property_readonly("run_info", &runInfoOf, "run.json as last written (at the start, at finish())");
     bindParticles(c);
+    bindWalls(c);
 }
 
 }  // namespace haet::python

@@ -1,7 +1,8 @@
 #pragma once
 // The Python module's Simulation (docs/python.md): a RunSession driven from a script, its particles as numpy arrays
 // that view the store. Shared by the binding files: simulation.cpp (making, running, outputs), particles.cpp (the
-// views and the changes made through them), module.cpp (the module, its exceptions).
+// views and the changes made through them), walls.cpp (the walls and changes of their motion), module.cpp (the
+// module, its exceptions).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -77,7 +78,7 @@ private:
     std::unique_ptr<RunSession> run_;
     /// What each view showed when it was handed out (empty: not handed out since the last commit).
     std::vector<std::string> shown_ = std::vector<std::string>(static_cast<int>(Field::Count));
-    bool changed_ = false;  ///< gravity set, or particles changed by the module itself
+    bool changed_ = false;  ///< gravity or a wall's motion set, or particles changed by the module itself
     /// The World's particles are at the run's time (synchronised since it last went on): a second synchronise
     /// would overwrite what a view wrote with the event-driven engine's own copy.
     bool current_ = false;
@@ -92,6 +93,7 @@ struct Errors {
 
 void bindSimulation(py::module_& m);
 void bindParticles(py::class_<Simulation>& c);
+void bindWalls(py::class_<Simulation>& c);
 /// A scenario from a Python dict: its TOML text (a dict of tables, lists of tables as [[arrays of tables]]).
 std::string tomlOfDict(const py::dict& d);
 

@@ -51,6 +51,13 @@ public:
     Flow(const Scenario& sc, const World<D>& world, double dt);
 
     bool empty() const { return sc_.inlets.empty() && sc_.outlets.empty(); }
+    /// n ids for particles added from outside (a script's Simulation.add_particles): the first of n consecutive
+    /// ones from the counter the inlets draw from, so that no two particles of a run ever share an id.
+    std::uint64_t takeIds(std::uint64_t n) {
+        const std::uint64_t first = nextId_;
+        nextId_ += n;
+        return first;
+    }
     /// How many ids outlet k (a counter) remembers as counted: at most the particles in the run.
     std::size_t remembered(std::size_t k) const { return outlets_[k].seen.size(); }
     /// The next time at which act() has work [s] (infinity: none).

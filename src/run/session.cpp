@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <limits>
 #include <optional>
 #include <ostream>
 
@@ -184,10 +185,17 @@ public:
                 // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
                 const double target = std::min(
                     {until, rows_.next(), shots_.next(), ckpts_.next(), flow_->nextTime(), measures_->nextTime()});
-                // The force pass at the next time the measurements read them records its contacts.
+                // The force pass at the next time the measurements read them records its contacts: at rows and
+                // snapshots, and at the end of this call when the last state may be written there (finish). A
+                // script's call ends anywhere, its loop of single steps would record at every step (a force pass
+                // of its own), so only a call that reaches the scenario's end records at its end; a script that
+                // finishes elsewhere writes the last row's stress without contacts, as a run stopped by a signal.
+                const double last = scope_ == StopScope::Run || until + eps_ >= sc_.duration
+                                        ? until
+                                        : std::numeric_limits<double>::infinity();
                 if (measures_->wantsContacts())
                     eng_->recordContactsAt(measures_->sink(),
-                                           measures_->contactsWantedAt(rows_.next(), shots_.next(), until));
+                                           measures_->contactsWantedAt(rows_.next(), shots_.next(), last));
                 while (chunks_.due(world.time, eps_)) chunks_.pass(world.time, eps_);
                 eng_->advanceTo(chunks_.next() < target - eps_ ? chunks_.next() : target);
                 if (world.time + eps_ >= flow_->nextTime()) flow_->act(world, *eng_, eps_);
@@ -268,6 +276,7 @@ public:
     }
     void stateChanged() override { eng_->stateChanged(); }
     void added(std::size_t first) override { eng_->added(first); }
+    std::uint64_t takeIds(std::uint64_t n) override { return flow_->takeIds(n); }
     void remove(const std::vector<std::uint32_t>& which) override { eng_->remove(which); }
     void save(const std::filesystem::path& file) override {
         if (!checkpoints_)

@@ -59,6 +59,9 @@ public:
     virtual void stateChanged() = 0;
     /// Particles [first, size()) were appended to the World: the engine takes them (as an inlet's).
     virtual void added(std::size_t first) = 0;
+    /// The first of n consecutive ids for particles to be appended, from the counter the inlets draw from (ids are
+    /// never reused, not even those of removed particles).
+    virtual std::uint64_t takeIds(std::uint64_t n) = 0;
     /// Removes World particles `which` (ascending, distinct), as an outlet does.
     virtual void remove(const std::vector<std::uint32_t>& which) = 0;
     /// Writes a checkpoint of the state now to `file` (atomically), to start a run from (RunOptions::startFrom).

@@ -305,8 +305,13 @@ void TdmEngine<D>::remap(const std::vector<std::uint32_t>& from) {
 template <int D>
 void TdmEngine<D>::restart() {
     pristine_ = false;
-    // The constructor's sequence, without its sort (the particles keep their places) and its walls' move (the
-    // walls are at the current time already).
+    // The constructor's sequence without its sort (the particles keep their places). The walls are where they were
+    // at this time, but their motion may have changed (Motion::rebase, Wall::setVelocity): their velocities now, and
+    // whether all stand still (the candidates' margin), anew.
+    staticSurfaces_ = true;
+    for (const SurfaceWall<D>& wall : w_.surfaces) staticSurfaces_ = staticSurfaces_ && !wall.motion.moves();
+    for (Wall<D>& wall : w_.walls) wall.moveTo(w_.time);
+    for (std::size_t q = 0; q < surf_.poses.size(); ++q) surf_.poses[q] = w_.surfaces[q].motion.at(w_.time);
     rebuild(false);
     motion_.v = w_.particles.v;
     motion_.w = w_.particles.w;

@@ -44,6 +44,29 @@ void saveWorld(ByteWriter& out, const World<D>& w) {
     out.putVector(p.shapes.vertices);
     out.putVector(p.shapes.inertiaPerMass);
     out.putVector(p.shapes.area);
+    // The walls whose motion a script changed (Wall::setVelocity, Motion::rebase): the rest follow from the
+    // scenario and the time, so that a resume with a changed scenario takes their motion from it.
+    for (const Wall<D>& wall : w.walls) {
+        out.put<std::uint8_t>(wall.changed);
+        if (!wall.changed) continue;
+        out.put(wall.point);
+        out.put(wall.velocity);
+        out.put<double>(wall.phase);
+        out.put<double>(wall.origin);
+    }
+    for (const SurfaceWall<D>& wall : w.surfaces) {
+        const Motion<D>& m = wall.motion;
+        out.put<std::uint8_t>(m.rebased);
+        if (!m.rebased) continue;
+        out.put(m.velocity);
+        out.put<double>(m.phase);
+        out.put(m.axis);
+        out.put<double>(m.omega);
+        out.put<double>(m.origin);
+        out.put(m.baseRot.m);
+        out.put(m.baseShift);
+        out.put<std::uint8_t>(m.baseRotated);
+    }
 }
 
 template <int D>
@@ -106,9 +129,45 @@ void loadWorld(ByteReader& in, World<D>& w) {
         for (int k = 0; k < D; ++k)
             if (std::abs(x[k] - 0.5 * (w.domain.lo[k] + w.domain.hi[k])) > (kMaxBoxLengths + 0.5) * extent)
                 in.fail("a position lies more than 1000 box lengths from the box");
+    std::vector<Wall<D>> planes = w.walls;
+    for (Wall<D>& wall : planes) {
+        if (in.get<std::uint8_t>() == 0) continue;
+        wall.point = in.get<Vec<D>>();
+        wall.velocity = in.get<Vec<D>>();
+        wall.phase = in.get<double>();
+        wall.origin = in.get<double>();
+        wall.changed = true;
+        if (!allFinite(std::vector<Vec<D>>{wall.point, wall.velocity}) || !std::isfinite(wall.phase) ||
+            !std::isfinite(wall.origin))
+            in.fail("a plane's motion is not finite");
+    }
+    std::vector<Motion<D>> motions;
+    for (const SurfaceWall<D>& wall : w.surfaces) {
+        Motion<D> m = wall.motion;
+        if (in.get<std::uint8_t>() != 0) {
+            m.velocity = in.get<Vec<D>>();
+            m.phase = in.get<double>();
+            m.axis = in.get<Ang<D>>();
+            m.omega = in.get<double>();
+            m.origin = in.get<double>();
+            m.baseRot.m = in.get<decltype(m.baseRot.m)>();
+            m.baseShift = in.get<Vec<D>>();
+            m.baseRotated = in.get<std::uint8_t>() != 0;
+            m.rebased = true;
+            bool finite = allFinite(std::vector<Vec<D>>{m.velocity, m.baseShift}) && std::isfinite(m.phase) &&
+                          std::isfinite(m.omega) && std::isfinite(m.origin);
+            for (int k = 0; k < kAngDim<D>; ++k) finite = finite && std::isfinite(m.axis[k]);
+            for (const auto& row : m.baseRot.m)
+                for (double a : row) finite = finite && std::isfinite(a);
+            if (!finite) in.fail("a wall's motion is not finite");
+        }
+        motions.push_back(m);
+    }
     q.nTdm = nTdm;
     p = std::move(q);
     w.time = time;
+    w.walls = std::move(planes);
+    for (std::size_t k = 0; k < motions.size(); ++k) w.surfaces[k].motion = motions[k];
     for (Wall<D>& wall : w.walls) wall.moveTo(time);
 }
 

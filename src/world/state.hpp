@@ -1,8 +1,9 @@
 #pragma once
 // The World's part of a checkpoint (ARCHITECTURE.md, "Checkpoints"): the time and every array of the particle store,
-// in its current order (the engines' saved state refers to particles by index). The box, the walls and the contact
-// table are not saved: they come from the scenario, which a resume must leave unchanged in them. The walls' places
-// follow from the time alone (moving and oscillating walls are functions of t).
+// in its current order (the engines' saved state refers to particles by index), and the motion of the walls a script
+// changed (Simulation.set_wall). The box, the other walls and the contact table are not saved: they come from the
+// scenario, which a resume must leave unchanged in them; their places follow from the time alone (moving and
+// oscillating walls are functions of t).
 #include "io/checkpoint.hpp"
 #include "world/world.hpp"
 

@@ -2,7 +2,8 @@
 // sections, as `haet run --resume` does (run/runner.cpp): the scenario's keys (SCEN), the World's particles (WRLD,
 // loadWorld) and the time- or event-driven engine's state (ENGN, made on the loaded World as a resumed run makes
 // it). The scenes are examples/drop3d_tiny.toml (3D) and examples/elastic_gas2d.toml (2D, with 8 particles), as
-// "tdm" or "edm"; the seeds are checkpoints of their runs.
+// "tdm" or "edm"; the seeds are checkpoints of their runs, which tests/fuzz/make_checkpoint_seeds.py writes anew after
+// a change of the format (kCheckpointVersion).
 //
 // The first byte picks how the rest is taken: odd, as a whole file (magic, version, length, CRC-32, body), which
 // exercises the checks of the header; even, as a body that the target seals with a valid header and checksum, so

@@ -11,6 +11,7 @@ SOURCE = pathlib.Path(__file__).resolve().parents[2]
 
 
 EXAMPLE = SOURCE / "examples" / "box2d_settle.toml"
+HOPPER = SOURCE / "examples" / "hopper2d.toml"
 
 
 def box2d(method="tdm", count=400, velocity=(0.0, 0.0), gravity=(0.0, -9.81), duration=0.05):

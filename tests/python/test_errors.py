@@ -35,6 +35,23 @@ def test_a_missing_file_and_unknown_keys_raise_scenario_error(tmp_path):
         haet.Simulation.from_dict({"name": object()})
 
 
+def test_a_bad_dict_raises_scenario_error_naming_the_dict():
+    import tomllib
+    d = tomllib.loads(EXAMPLE.read_text())
+    d["materials"]["sand"]["friction"] = -1.0
+    with pytest.raises(haet.ScenarioError) as e:
+        haet.Simulation.from_dict(d)
+    assert e.value.file == "<dict>"
+    assert e.value.line == 0  # the dict has no lines
+    assert e.value.key == "materials.sand.friction"
+    assert str(e.value).startswith("<dict>: materials.sand.friction: ")
+    del d["materials"]["sand"]["friction"]
+    d["domain"]["gravity"] = "down"
+    with pytest.raises(haet.ScenarioError) as e:
+        haet.Simulation.from_dict(d)
+    assert e.value.file == "<dict>" and e.value.key == "domain.gravity"
+
+
 def test_a_blow_up_raises_simulation_error():
     # a time step far above the contact duration: the overlaps grow past the limit
     with small(velocity=(0.0, -2.0), extra=["tdm.dt=2e-4"]) as sim:

@@ -122,3 +122,34 @@ def test_the_hybrid_views_are_read_only():
             sim.positions[0, 0] = 1.0
         with pytest.raises(ValueError, match="hybrid"):
             sim.gravity = [0.0, -1.0]
+
+
+# examples/box2d_settle.toml's box fed from above by an inlet
+INLET = """
+[[inlet]]
+name = "feed"
+material = "sand"
+region = { lo = [0.02, 0.12], hi = [0.08, 0.145] }
+rate = 4000
+interval = 0.002
+radius = 0.001
+"""
+
+
+@pytest.mark.parametrize("method", ["tdm", "edm"])
+def test_added_particles_take_their_ids_from_the_inlets_counter(method):
+    text = EXAMPLE.read_text() + INLET
+    with haet.Simulation.from_string(text, path=EXAMPLE, set=box2d(method=method, count=100)) as sim:
+        sim.add_particles([[0.05, 0.08]], [0.001])
+        assert sim.n_particles == 101 and 100 in set(sim.ids)
+        sim.run(until=0.01)
+        inserted = sim.n_particles - 101
+        assert inserted > 0
+        assert len(set(sim.ids)) == sim.n_particles  # none shares an id
+        # ids are never reused: not even the largest one's, removed
+        top = int(max(sim.ids))
+        sim.remove([top])
+        sim.add_particles([[0.05, 0.09]], [0.001])
+        assert int(max(sim.ids)) == top + 1
+        sim.run(until=0.02)
+        assert len(set(sim.ids)) == sim.n_particles
