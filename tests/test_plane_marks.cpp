@@ -80,8 +80,8 @@ TEST(PlaneMarks, APlaneMovedFromOutsideIsTestedByEveryParticle) {
 }
 
 TEST(PlaneMarks, MovingPlanesAreNotMarked) {
-    const Scenario sc = exampleScenario("box3d_settle.toml",
-                                        {"insert[1].count=300", "walls[1].velocity=[0.0, 0.0, 0.01]"});
+    const Scenario sc =
+        exampleScenario("box3d_settle.toml", {"insert[1].count=300", "walls[1].velocity=[0.0, 0.0, 0.01]"});
     World<3> w = buildWorld<3>(sc);
     TdmEngine<3> e(w, tdmSettings<3>(sc, w));
     e.advanceTo(0.005);
