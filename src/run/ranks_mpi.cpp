@@ -55,22 +55,30 @@ public:
         for (std::size_t r = 0; r < nr; ++r)
             if (static_cast<int>(r) != rank_) sizes[r] = static_cast<long long>(send[r].size());
         MPI_Alltoall(sizes.data(), 1, MPI_LONG_LONG, got.data(), 1, MPI_LONG_LONG, MPI_COMM_WORLD);
+        std::vector<std::size_t> bytes(nr);
+        for (std::size_t r = 0; r < nr; ++r) bytes[r] = static_cast<std::size_t>(got[r]);
+        return exchangeKnown(send, bytes);
+    }
+    std::vector<std::vector<char>> exchangeKnown(const std::vector<std::vector<char>>& send,
+                                                 const std::vector<std::size_t>& recvBytes) override {
+        *talking_ = true;
+        const std::size_t nr = static_cast<std::size_t>(size_);
         std::vector<std::vector<char>> recv(nr);
         std::vector<MPI_Request> reqs;
         for (std::size_t r = 0; r < nr; ++r) {
             if (static_cast<int>(r) == rank_) continue;
-            recv[r].resize(static_cast<std::size_t>(got[r]));
-            if (got[r] > 0) {
+            recv[r].resize(recvBytes[r]);
+            if (recvBytes[r] > 0) {
                 reqs.emplace_back();
-                MPI_Irecv(recv[r].data(), static_cast<int>(got[r]), MPI_BYTE, static_cast<int>(r), 0, MPI_COMM_WORLD,
-                          &reqs.back());
+                MPI_Irecv(recv[r].data(), static_cast<int>(recvBytes[r]), MPI_BYTE, static_cast<int>(r), 0,
+                          MPI_COMM_WORLD, &reqs.back());
             }
         }
         for (std::size_t r = 0; r < nr; ++r) {
-            if (static_cast<int>(r) == rank_ || sizes[r] == 0) continue;
+            if (static_cast<int>(r) == rank_ || send[r].empty()) continue;
             reqs.emplace_back();
-            MPI_Isend(send[r].data(), static_cast<int>(sizes[r]), MPI_BYTE, static_cast<int>(r), 0, MPI_COMM_WORLD,
-                      &reqs.back());
+            MPI_Isend(send[r].data(), static_cast<int>(send[r].size()), MPI_BYTE, static_cast<int>(r), 0,
+                      MPI_COMM_WORLD, &reqs.back());
         }
         MPI_Waitall(static_cast<int>(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
         return recv;

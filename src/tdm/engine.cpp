@@ -305,11 +305,10 @@ void TdmEngine<D>::contactCounts(std::vector<std::uint8_t>& out) const {
 template <int D>
 void TdmEngine<D>::step() {
     bool moved = integ_->predict(w_.particles, s_.dt, motion_, xAtBuild_.data(), driftLimit2());
-    if (halo_) {
-        bool stop = false;
-        agree(moved, stop);
-    }
+    bool stop = false;
+    if (halo_) agree(moved, stop);
     finishStep(moved, nullptr);
+    if (halo_) agree(moved, stop);  // this step's health, agreed before step() returns
 }
 
 template <int D>
@@ -323,7 +322,7 @@ void TdmEngine<D>::finishStep(bool moved, std::atomic<bool>* nextMoved) {
         rebuild(s_.sortEvery > 0 && steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery));
         // O(N) beside the O(N) rebuild; a system that blows up rebuilds at every step
         if (halo_)
-            together([&] { checkSpeeds(); });
+            check([&] { checkSpeeds(); });
         else
             checkSpeeds();
     } else if (halo_) {
@@ -335,7 +334,7 @@ void TdmEngine<D>::finishStep(bool moved, std::atomic<bool>* nextMoved) {
     computeForces(true, nextMoved);
     if (recordNow_) recorded();
     if (halo_)
-        together([&] { checkHealth(); });
+        check([&] { checkHealth(); });
     else
         checkHealth();
 }
@@ -384,6 +383,11 @@ void TdmEngine<D>::advanceTo(double t) {
         finishStep(moved, predicted ? &nextMoved : nullptr);
         moved = nextMoved.load(std::memory_order_relaxed);
         if (stop) break;
+    }
+    // The last step's health, agreed before the call returns (the moved and stop bits are not used).
+    if (halo_) {
+        bool stop = false;
+        agree(moved, stop);
     }
 }
 

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "contact/kinds.hpp"
@@ -132,14 +133,16 @@ private:
     double driftLimit2() const { return 0.25 * s_.skin * s_.skin; }
     void rebuild(bool sort);
     // Across ranks (tdm/ranks.cpp): the first cut into slabs, the rebuild that migrates particles with their springs
-    // and makes the ghosts anew, the ghosts' state after every other prediction, the ranks' agreement on whether to
-    // rebuild and stop, and a health check that fails on every rank when it fails on one.
+    // and makes the ghosts anew, the ghosts' state after every other prediction, and the ranks' agreement, after each
+    // prediction, on whether to rebuild and stop and on whether a health check failed on any rank since the last
+    // agreement (then every rank throws its SimulationError): one collective a step. check runs a health check,
+    // keeping its failure for the agreement.
     void scatterToSlabs();
     void rebuildAcrossRanks(bool sort);
     void refreshGhosts();
     void agree(bool& moved, bool& stop);
     template <class Check>
-    void together(Check check) const;
+    void check(Check run);
     double contactEnergyShare() const;
     /// Planes and walls of any shape to the current time; the candidates rebuilt if a wall moved too far.
     void moveWalls();
@@ -178,6 +181,7 @@ private:
     struct Halo;                  ///< across ranks: the slabs, the ghosts and who sends them (tdm/halo.hpp)
     std::unique_ptr<Halo> halo_;  ///< null in one process
     std::size_t nOwned_ = 0;      ///< across ranks: particles [0, nOwned_) are this rank's, the rest ghosts
+    std::string failure_;         ///< across ranks: a health check's failure since the last agreement
 };
 
 }  // namespace haet

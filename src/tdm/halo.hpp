@@ -23,28 +23,12 @@ struct TdmEngine<D>::Halo {
 
 template <int D>
 template <class Check>
-void TdmEngine<D>::together(Check check) const {
-    std::string failure;
+void TdmEngine<D>::check(Check run) {
     try {
-        check();
+        run();
     } catch (const SimulationError& e) {
-        failure = e.what();
+        if (failure_.empty()) failure_ = e.what();
     }
-    Ranks& ranks = *halo_->ranks;
-    if (!ranks.any(!failure.empty())) return;
-    // Every rank stops with the message of the lowest rank that failed.
-    std::vector<std::vector<char>> send(static_cast<std::size_t>(ranks.size()));
-    for (int r = 0; r < ranks.size(); ++r)
-        if (r != ranks.rank()) send[r].assign(failure.begin(), failure.end());
-    const auto got = ranks.exchange(send);
-    for (int r = 0; r < ranks.size(); ++r) {
-        if (r == ranks.rank() && !failure.empty()) break;
-        if (r != ranks.rank() && !got[r].empty()) {
-            failure.assign(got[r].begin(), got[r].end());
-            break;
-        }
-    }
-    throw SimulationError(failure);
 }
 
 }  // namespace haet

@@ -166,9 +166,28 @@ void TdmEngine<D>::scatterToSlabs() {
 
 template <int D>
 void TdmEngine<D>::agree(bool& moved, bool& stop) {
-    const std::uint32_t bits = halo_->ranks->orBits((moved ? 1u : 0u) | (stop ? 2u : 0u));
+    Ranks& ranks = *halo_->ranks;
+    const bool failed = !failure_.empty();
+    const std::uint32_t bits = ranks.orBits((moved ? 1u : 0u) | (stop ? 2u : 0u) | (failed ? 4u : 0u));
     moved = bits & 1u;
     stop = bits & 2u;
+    if (!(bits & 4u)) return;
+    // A health check failed on some rank since the last agreement: every rank stops with the message of the lowest
+    // rank that failed.
+    std::string failure = failure_;
+    std::vector<std::vector<char>> send(static_cast<std::size_t>(ranks.size()));
+    for (int r = 0; r < ranks.size(); ++r)
+        if (r != ranks.rank()) send[r].assign(failure.begin(), failure.end());
+    const auto got = ranks.exchange(send);
+    for (int r = 0; r < ranks.size(); ++r) {
+        if (r == ranks.rank() && failed) break;
+        if (r != ranks.rank() && !got[r].empty()) {
+            failure.assign(got[r].begin(), got[r].end());
+            break;
+        }
+    }
+    failure_.clear();
+    throw SimulationError(failure);
 }
 
 template <int D>
@@ -419,7 +438,12 @@ void TdmEngine<D>::refreshGhosts() {
             out.put(motion_.w[i]);
         }
     }
-    const auto got = ranks.exchange(send);
+    // The ghosts of each rank are as many as at the rebuild: the sizes are known, and only neighbours talk.
+    constexpr std::size_t kBytes = 3 * sizeof(Vec<D>) + 2 * sizeof(Ang<D>);
+    std::vector<std::size_t> bytes(static_cast<std::size_t>(nr), 0);
+    for (int r = 0; r < nr; ++r)
+        if (r != me) bytes[r] = (h.ghostFirst[r + 1] - h.ghostFirst[r]) * kBytes;
+    const auto got = ranks.exchangeKnown(send, bytes);
     for (int r = 0; r < nr; ++r) {
         if (r == me) continue;
         ByteSource in{got[r]};

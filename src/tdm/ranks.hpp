@@ -28,6 +28,10 @@ public:
     virtual void max(std::vector<double>& v) = 0;
     /// send[r] goes to rank r (send[rank()] is not sent); returns what each rank sent here, by rank.
     virtual std::vector<std::vector<char>> exchange(const std::vector<std::vector<char>>& send) = 0;
+    /// The same when every rank knows how many bytes each other rank sends it (recvBytes[r]): only the ranks that
+    /// send or receive something talk, point to point, with no collective first (the ghosts' state every step).
+    virtual std::vector<std::vector<char>> exchangeKnown(const std::vector<std::vector<char>>& send,
+                                                         const std::vector<std::size_t>& recvBytes) = 0;
 };
 
 /// The cut of the box into one slab per rank along one axis. Rank r owns [cut[r-1], cut[r]), the first slab reaching

@@ -9,7 +9,8 @@ CHECK is one of
   momentum  the elastic periodic gas on 4 ranks: the momentum of series.csv stays at its start to round-off
   chute     the LAMMPS chute of bench/ (from its lattice, bench/make_chute_data.sh) on 1, 2 and 4 ranks: the kinetic
             energy and the mean velocity over the run agree with one rank's; prints whether they are the same bits
-  refuse    what does not run across ranks yet exits 2 naming the key (method, inlets, meshes), as bad input does
+  refuse    what does not run across ranks yet exits 2 naming the key (method, inlets, meshes), as bad input does;
+            a blow-up on one rank ends every rank with exit 3
 """
 import csv
 import json
@@ -192,6 +193,12 @@ def refuse():
         status, err = run(2, GAS, out, sets, expect=2)
         if key not in err:
             fail(f"{sets}: the error does not name {key}:\n{err[-2000:]}")
+    # A blow-up on one rank (an overlap beyond max_overlap, first met by whichever rank holds the pair) stops every
+    # rank after the same step: exit 3, run.json "failed: ..." naming the particle, as from one process.
+    out = os.path.join(WORK, "blowup")
+    status, err = run(2, GAS, out, GAS_SETS + ["tdm.max_overlap=1e-4"], expect=3)
+    if status == 3 and not run_json(out)["status"].startswith("failed: overlap"):
+        fail(f"the blow-up's run.json status: {run_json(out)['status']}")
     inlet = os.path.join(SRC, "examples", "pour3d.toml")
     status, err = run(2, inlet, os.path.join(WORK, "refused"), ["output.stress=false"], expect=2)
     if "inlet" not in err:
