@@ -9,6 +9,8 @@ CHECK is one of
   momentum  the elastic periodic gas on 4 ranks: the momentum of series.csv stays at its start to round-off
   chute     the LAMMPS chute of bench/ (from its lattice, bench/make_chute_data.sh) on 1, 2 and 4 ranks: the kinetic
             energy and the mean velocity over the run agree with one rank's; prints whether they are the same bits
+  walls     beads settling in a box of planes (slabs across the height, the cuts placed again as they fall) on 1, 2
+            and 4 ranks: the kinetic energy and the floor's load over the run agree with one rank's
   refuse    what does not run across ranks yet exits 2 naming the key (method, inlets, meshes), as bad input does;
             a blow-up on one rank ends every rank with exit 3
 """
@@ -184,6 +186,46 @@ def chute():
             fail(f"-np {ranks}: the particle count differs from one rank's")
 
 
+def walls():
+    # Beads dropped into a box of five planes (no periodic axis: the slabs cut the height, and the cuts move as the
+    # beads fall, by the re-placement when the counts drift apart) on 1, 2 and 4 ranks: the kinetic energy and the
+    # floor's load over the run agree with one rank's, the particles are kept.
+    scenario = os.path.join(SRC, "examples", "box3d_settle.toml")
+    sets = ["duration=0.08", "output.series_period=0.002", "output.snapshot_period=-1", "output.stress=false",
+            "walls[1].name=\"floor\""]
+    got = {}
+    for ranks in (1, 2, 4):
+        out = os.path.join(WORK, f"walls{ranks}")
+        status, _ = run(ranks, scenario, out, sets)
+        if status == 0:
+            got[ranks], _ = series(out)
+            if ranks > 1:
+                j = run_json(out)
+                print(f"-np {ranks}: {j.get('migrated')} migrations, cuts placed again "
+                      f"{j['decomposition']['rebalances']} times, axis {j['decomposition']['axis']}")
+                ids = final_ids(out)
+                if len(set(ids)) != 2000 or len(ids) != 2000:
+                    fail(f"-np {ranks}: final.data holds {len(ids)} particles, {len(set(ids))} ids (2000 expected)")
+    if 1 not in got:
+        return
+    one = got[1]
+
+    def mean(v):
+        return sum(v) / len(v)
+
+    for ranks in (2, 4):
+        if ranks not in got:
+            continue
+        s = got[ranks]
+        # The floor's load is sampled every 2 ms while beads land on it: noisier than the energy.
+        for name, tol in (("kinetic_energy", 0.02), ("floor_fz", 0.05)):
+            rel = abs(mean(s[name]) - mean(one[name])) / abs(mean(one[name]))
+            print(f"-np {ranks}: {name} over the run {mean(s[name]):.6g}, one rank {mean(one[name]):.6g}, "
+                  f"relative {rel:.2e}")
+            if not rel < tol:
+                fail(f"-np {ranks}: {name} over the run differs from one rank's by {rel:.2e}")
+
+
 def refuse():
     for sets, key in ((["method=\"edm\""], "method"), (["method=\"haet\""], "method"),
                       (["tdm.integrator=\"gear5\"", "output.stress=false"], "tdm.integrator"),
@@ -206,7 +248,7 @@ def refuse():
 
 
 os.makedirs(WORK, exist_ok=True)
-{"conserve": conserve, "momentum": momentum, "chute": chute, "refuse": refuse}[CHECK]()
+{"conserve": conserve, "momentum": momentum, "chute": chute, "walls": walls, "refuse": refuse}[CHECK]()
 if failures:
     sys.exit(1)
 print("ok")
