@@ -5,7 +5,8 @@ FUZZ_BUILD ?= build-fuzz
 JOBS ?= $(shell nproc)
 DEB_PACKAGES = cmake g++ make pkg-config libgtest-dev libbenchmark-dev libtomlplusplus-dev libcli11-dev \
                libfmt-dev libcairo2-dev libpng-dev nlohmann-json3-dev zlib1g-dev clang-format python3 \
-               pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
+               pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib \
+               libopenmpi-dev openmpi-bin
 # make fuzz: clang with libFuzzer and its sanitizer runtimes, LLVM's OpenMP.
 FUZZ_DEB_PACKAGES = clang libclang-rt-14-dev libomp-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)

@@ -17,6 +17,7 @@
 #include "io/checkpoint.hpp"
 #include "io/png.hpp"
 #include "io/table.hpp"
+#include "run/ranks_mpi.hpp"
 #include "run/render.hpp"
 #include "run/runner.hpp"
 #include "scenario/loader.hpp"
@@ -38,8 +39,24 @@ void passiveOpenMpWaiting(char** argv) {
 
 }  // namespace
 
+/// The command; *thrown: whether it ended by an exception (an error that may be this rank's alone).
+int runCommand(int argc, char** argv, haet::MpiScope& mpi, bool* thrown);
+
 int main(int argc, char** argv) {
     passiveOpenMpWaiting(argv);
+    // After the program has executed itself again: MPI is initialised once, in the process that runs.
+    haet::MpiScope mpi(argc, argv);
+    bool thrown = false;
+    const int code = runCommand(argc, argv, mpi, &thrown);
+    // An error thrown after the ranks started talking may be one rank's alone (an output rank 0 cannot write): the
+    // others wait in a collective, so all end at once, with the same exit code. Before that, every rank read the same
+    // input and fails alike; a blow-up or a signal the ranks agree on (run/session.cpp). MPI is finalised as the
+    // scope ends.
+    if (thrown && mpi.talking()) mpi.abort(code);
+    return code;
+}
+
+int runCommand(int argc, char** argv, haet::MpiScope& mpi, bool* thrown) {
     // Large buffers (pair lists rebuilt every ~100 steps, file contents at set-up) go straight to the system
     // and back when freed. By default glibc raises this threshold to the size of the last freed buffer, after
     // which buffers come from the heap and the freed ones stay resident (3D chute benchmark, 1 500 steps: peak
@@ -128,6 +145,11 @@ int main(int argc, char** argv) {
                                  progress ? haet::ProgressDisplay::On
                                           : (quiet ? haet::ProgressDisplay::Off : haet::ProgressDisplay::Auto),
                                  resumeDir};
+            opt.ranks = mpi.ranks();
+            if (mpi.rank() != 0) {  // rank 0 reports for the run
+                opt.quiet = true;
+                opt.progress = haet::ProgressDisplay::Off;
+            }
             return static_cast<int>(haet::runScenario(sc, opt, std::cerr));
         }
         if (*render) {
@@ -187,18 +209,23 @@ int main(int argc, char** argv) {
         std::cout << "ok\n";
         return 0;
     } catch (const haet::ScenarioError& e) {
+        *thrown = true;
         std::cerr << "error: " << e.what() << "\n";
         return 2;
     } catch (const haet::CheckpointError& e) {  // --resume: corrupt, truncated, a later format, another scenario
+        *thrown = true;
         std::cerr << "error: --resume: " << e.what() << "\n";
         return 2;
     } catch (const std::invalid_argument& e) {
+        *thrown = true;
         std::cerr << "error: " << e.what() << "\n";
         return 2;
     } catch (const haet::IoError& e) {
+        *thrown = true;
         std::cerr << "error: cannot write an output: " << e.what() << "\n";
         return static_cast<int>(haet::RunStatus::OutputFailed);
     } catch (const std::exception& e) {
+        *thrown = true;
         std::cerr << "error: " << e.what() << "\n";
         return 1;
     }

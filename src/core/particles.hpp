@@ -14,7 +14,13 @@ namespace haet {
 /// Per-particle flag bits.
 enum ParticleFlag : std::uint8_t {
     kFrozen = 1u << 0,  ///< not integrated: position and velocity stay as given (a rough base, a fixture)
+    /// A copy of another rank's particle (a run across MPI ranks, tdm/ranks.hpp): its forces are that rank's to
+    /// compute, and its state is overwritten from there every step.
+    kGhost = 1u << 1,
 };
+/// Two particles that share one of these bits are never paired: two frozen ones never move apart or together, and
+/// the pair of two ghosts is computed by a rank that owns one of them.
+inline constexpr std::uint8_t kUnpaired = kFrozen | kGhost;
 
 /// Shape factor q of the moment of inertia I = q m a^2 (docs/physics.md B.4): solid disk 1/2, solid sphere 2/5.
 template <int D>

@@ -114,7 +114,7 @@ std::vector<Vec<D>> makeShiftVectors(const Domain<D>& dom) {
 template <int D>
 inline bool testPair(const Particles<D>& p, const Domain<D>& dom, const NeighborSettings& s, std::uint32_t i,
                      std::uint32_t j, std::uint8_t& code, double extra = 0) {
-    if (s.excludeFrozenPairs && (p.flags[i] & p.flags[j] & kFrozen)) return false;
+    if (s.excludeFrozenPairs && (p.flags[i] & p.flags[j] & kUnpaired)) return false;
     // Domain::minimumImage, keeping the number of box lengths added for the shift code.
     Vec<D> d = p.x[i] - p.x[j];
     int cd = 0, mul = 1;
@@ -259,7 +259,7 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
         nb.of(cellOf[i]);
         const auto* cells = nb.list;
         const std::uint32_t* m = members.data();
-        const bool frozen = s.excludeFrozenPairs && (p.flags[i] & kFrozen);
+        const std::uint8_t unpaired = s.excludeFrozenPairs ? p.flags[i] & kUnpaired : 0;
         for (int q = 0, nc = nb.count; q < nc; ++q) {
             const std::uint32_t* end = m + cellStart[cells[q].cell + 1];
             const std::uint32_t* a = std::upper_bound(m + cellStart[cells[q].cell], end, static_cast<std::uint32_t>(i));
@@ -274,7 +274,7 @@ void buildPairList(const Particles<D>& p, const Domain<D>& dom, const NeighborSe
             const Vec<D> xi = p.x[i] + out.shiftVec[code];
             for (; a != end; ++a) {
                 const std::uint32_t j = *a;
-                if (frozen && (p.flags[j] & kFrozen)) continue;
+                if (unpaired & p.flags[j]) continue;
                 const double cut = p.radius[i] + p.radius[j] + s.skin;
                 if (norm2(xi - p.x[j]) < cut * cut) add(j, code);
             }

@@ -58,7 +58,7 @@ struct PairList {
 
 struct NeighborSettings {
     double skin = 0;                 ///< [m]
-    bool excludeFrozenPairs = true;  ///< pairs of two frozen particles never matter
+    bool excludeFrozenPairs = true;  ///< pairs of two frozen particles (or two ghosts: kUnpaired) never matter
 };
 
 /// Builds the pair list with a cell grid. Positions must already be wrapped into the box on periodic axes.

@@ -2,6 +2,7 @@
 // The engines as the run loop sees them: one Driver per method (time-driven, event-driven, hybrid) gives the loop
 // the same calls (advance, synchronise, the series' columns, checkpoints) and lets the inlets and outlets add and
 // remove particles (FlowHost). Used by run/session.cpp only.
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -23,18 +24,21 @@ namespace haet {
 template <int D>
 struct Energies {
     double kinetic = 0, rotational = 0, potential = 0;
-    double mv2 = 0;  ///< sum m v^2 [J], for the kinetic pressure
+    double mv2 = 0;   ///< sum m v^2 [J], for the kinetic pressure
+    Vec<D> momentum;  ///< sum m v [kg m/s]
 };
 
+/// The energies of particles [0, n) (default: all; across ranks, a rank's own).
 template <int D>
-Energies<D> energies(const World<D>& w) {
+Energies<D> energies(const World<D>& w, std::size_t n = static_cast<std::size_t>(-1)) {
     const Particles<D>& p = w.particles;
     Energies<D> s;
-    for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t i = 0; i < std::min(n, p.size()); ++i) {
         const double m = p.mass[i];
         const double v2 = norm2(p.v[i]);
         s.kinetic += 0.5 * m * v2;
         s.mv2 += m * v2;
+        s.momentum += p.v[i] * m;
         s.rotational += 0.5 * p.inertia(i) * norm2(p.w[i]);
         s.potential -= m * dot(w.domain.gravity, w.domain.unwrap(p.x[i], p.image[i]));
     }
@@ -56,9 +60,15 @@ public:
     virtual void synchronise() {}
     /// Time resolution of the engine: the loop treats times closer than this as equal [s].
     virtual double timeTolerance() const = 0;
-    virtual double dt() const = 0;             ///< time step [s] (0 for a pure event-driven run)
-    virtual std::uint64_t steps() const = 0;   ///< time steps taken (0 for a pure event-driven run)
+    virtual double dt() const = 0;            ///< time step [s] (0 for a pure event-driven run)
+    virtual std::uint64_t steps() const = 0;  ///< time steps taken (0 for a pure event-driven run)
+    /// Particles [0, owned()) of the World are this rank's (across ranks: the rest are ghosts); one process: all.
+    virtual std::size_t owned() const { return static_cast<std::size_t>(-1); }
     virtual std::size_t contacts() const = 0;  ///< enduring contacts now
+    /// Across ranks, this rank's share of them (TdmEngine::contactShare); one process: contacts().
+    virtual double contactShare() const { return static_cast<double>(contacts()); }
+    /// Across ranks: the particles this rank handed to another so far (0 in one process).
+    virtual double migrated() const { return 0; }
     virtual double maxOverlapRatio() const = 0;
     virtual double elasticEnergy() const = 0;  ///< energy stored in contacts [J]
     /// Sum of r_ij . F_ij (soft contacts) plus collision virial / window (hard collisions) [J].
@@ -104,13 +114,17 @@ void loadEngineState(const CheckpointFile& f, World<D>& w, Engine& eng) {
 template <int D>
 class TdmDriver final : public Driver<D> {
 public:
-    TdmDriver(World<D>& w, const TdmSettings& s, std::string dtNote) : w_(w), eng_(w, s), note_(std::move(dtNote)) {}
+    TdmDriver(World<D>& w, const TdmSettings& s, std::string dtNote)
+        : w_(w), eng_(w, s), note_(std::move(dtNote)), ranks_(s.ranks && s.ranks->size() > 1 ? s.ranks : nullptr) {}
     const char* method() const override { return "tdm"; }
+    std::size_t owned() const override { return eng_.owned(); }
     void advanceTo(double t) override { eng_.advanceTo(t); }
     double timeTolerance() const override { return 0.5 * eng_.settings().dt; }
     double dt() const override { return eng_.settings().dt; }
     std::uint64_t steps() const override { return eng_.steps(); }
     std::size_t contacts() const override { return eng_.forceStats().contacts; }
+    double contactShare() const override { return eng_.contactShare(); }
+    double migrated() const override { return static_cast<double>(eng_.migrated()); }
     double maxOverlapRatio() const override { return eng_.forceStats().maxOverlapRatio; }
     double elasticEnergy() const override { return eng_.contactEnergy(); }
     double virial(double) override { return eng_.pairVirial(); }
@@ -122,12 +136,27 @@ public:
     std::vector<std::optional<double>> extraRow() const override {
         std::vector<std::optional<double>> r{double(eng_.rebuilds())};
         appendWallLoads(w_, eng_, r);
+        if (ranks_) {  // the walls' loads are sums over the particles, every rank its own (the rebuilds agree)
+            std::vector<double> v;
+            for (std::size_t k = 1; k < r.size(); ++k) v.push_back(r[k].value_or(0));
+            ranks_->sum(v);
+            for (std::size_t k = 1; k < r.size(); ++k)
+                if (r[k]) r[k] = v[k - 1];
+        }
         return r;
     }
     void describe(JsonObject& j) const override {
         j.add("dt", eng_.settings().dt);
         j.add("dt_rule", note_);
         j.add("neighbor_rebuilds", eng_.rebuilds());
+        if (const Slabs* s = eng_.slabs()) {
+            JsonObject d;
+            d.add("ranks", static_cast<std::int64_t>(s->ranks()));
+            d.add("axis", static_cast<std::int64_t>(s->axis));
+            d.add("cuts", s->cut);
+            d.add("rebalances", eng_.rebalances());
+            j.add("decomposition", d);
+        }
     }
     const TdmEngine<D>& engine() const { return eng_; }
     double stepTime() const override { return eng_.settings().dt; }
@@ -147,6 +176,7 @@ private:
     World<D>& w_;
     TdmEngine<D> eng_;
     std::string note_;
+    Ranks* ranks_;  ///< across ranks; null in one process
 };
 
 template <int D>
@@ -289,12 +319,14 @@ private:
 };
 
 template <int D>
-std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world, const std::atomic<bool>* stop) {
+std::unique_ptr<Driver<D>> makeDriver(const Scenario& sc, World<D>& world, const std::atomic<bool>* stop,
+                                      Ranks* ranks = nullptr) {
     switch (sc.method) {
         case Method::Tdm: {
             std::string note;
             TdmSettings ts = tdmSettings<D>(sc, world, &note);
             ts.stop = stop;
+            ts.ranks = ranks;
             return std::make_unique<TdmDriver<D>>(world, ts, note);
         }
         case Method::Edm: {

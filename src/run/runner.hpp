@@ -11,6 +11,8 @@
 
 namespace haet {
 
+class Ranks;
+
 /// The progress line on stderr: Auto shows it on a terminal unless quiet. It never changes what is computed.
 enum class ProgressDisplay { Auto, On, Off };
 
@@ -31,6 +33,9 @@ struct RunOptions {
     /// Non-empty: start from this checkpoint file (the state of a run saved by a script) with new outputs in the
     /// output directory, instead of from the scenario's initial state. The series starts at the checkpoint's time.
     std::filesystem::path startFrom;
+    /// More than one rank (`mpirun -np N haet run`, run/ranks_mpi.hpp): a time-driven run cut into slabs, rank 0
+    /// writing the outputs (docs/parallel.md). Null or one rank: the run of one process.
+    Ranks* ranks = nullptr;
 };
 
 /// The exit code of `haet run` for each outcome.

@@ -27,6 +27,7 @@
 #include "run/schedule.hpp"
 #include "run/snapshots.hpp"
 #include "run/stop.hpp"
+#include "tdm/ranks.hpp"
 
 namespace haet {
 namespace {
@@ -39,6 +40,28 @@ std::size_t peakRssBytes() {
     return static_cast<std::size_t>(ru.ru_maxrss) * 1024;
 }
 
+/// What a run across ranks does not do yet (docs/parallel.md): each refused with the key to change, before any rank
+/// talks to another, so that every rank fails alike (exit 2).
+void checkAcrossRanks(const Scenario& sc, const RunOptions& opt, int ranks) {
+    auto refuse = [&](const std::string& key, const std::string& what) {
+        throw std::invalid_argument(key + ": " + what + " does not run across ranks yet (mpirun -np " +
+                                    std::to_string(ranks) + "; docs/parallel.md): run it as one process");
+    };
+    if (sc.method != Method::Tdm)
+        refuse("method", std::string("method = \"") + (sc.method == Method::Edm ? "edm" : "haet") + "\"");
+    if (sc.tdm.integrator != IntegratorKind::Verlet) refuse("tdm.integrator", "an integrator other than \"verlet\"");
+    for (const WallDef& w : sc.walls)
+        if (w.type != WallType::Plane) refuse("walls", "a wall other than a plane (meshes, cylinders, ...)");
+    if (!sc.inlets.empty()) refuse("inlet", "an inlet");
+    if (!sc.outlets.empty()) refuse("outlet", "an outlet");
+    if (!sc.fields.empty()) refuse("fields", "a [[fields]] grid");
+    if (!sc.regions.empty()) refuse("regions", "a [[regions]] stress");
+    if (sc.output.stress) refuse("output.stress", "the stress tensor of the domain (the default; set it false)");
+    if (sc.output.contacts) refuse("output.contacts", "the contact network");
+    if (!opt.resumeDir.empty()) refuse("--resume", "resuming from a checkpoint");
+    if (!opt.startFrom.empty()) refuse("start", "starting from a checkpoint");
+}
+
 std::filesystem::path runDirectory(const Scenario& sc, const RunOptions& opt) {
     if (!opt.resumeDir.empty()) return opt.resumeDir;
     return opt.outDir.empty() ? std::filesystem::path(sc.output.directory) : opt.outDir;
@@ -49,6 +72,10 @@ class Session final : public RunSession {
 public:
     Session(const Scenario& sc, const RunOptions& opt, std::ostream& log)
         : sc_(sc), opt_(opt), log_(log), t0_(Clock::now()), dir_(runDirectory(sc_, opt_)), scope_(opt.stopSignals) {
+        if (opt.ranks && opt.ranks->size() > 1) {
+            checkAcrossRanks(sc_, opt_, opt.ranks->size());
+            ranks_ = opt.ranks;
+        }
         if (scope_ == StopScope::Run) signals_.emplace();
         // A resumed run starts from the newest whole checkpoint of its directory (or a script's from a saved file):
         // the World built from the scenario (box, walls, contact table) takes the saved particles, the engine is
@@ -63,7 +90,7 @@ public:
             loadWorld(in, world);
             in.expectEnd();
         }
-        eng_ = makeDriver<D>(sc_, world, StopSignals::flag());
+        eng_ = makeDriver<D>(sc_, world, StopSignals::flag(), ranks_);
         if (resume_) {
             if (!eng_->restartable())
                 throw std::invalid_argument(std::string("--resume: runs of method \"") + eng_->method() +
@@ -71,12 +98,16 @@ public:
             eng_->loadState(resume_->file);
         }
         plan_ = planRun(sc_, eng_->dt(), world.contact.contactTime);
-        for (const auto& [key, what] : plan_.warnings) log_ << "warning: " << key << ": " << what << "\n";
+        if (lead())
+            for (const auto& [key, what] : plan_.warnings) log_ << "warning: " << key << ": " << what << "\n";
 
-        if (!resume_ || startFrom) prepareRunDirectory(dir_);
+        // Across ranks rank 0 writes every output, of values reduced over the ranks.
+        if ((!resume_ || startFrom) && lead()) prepareRunDirectory(dir_);
         std::vector<std::string> columns = {
-            "time",         "step",        "kinetic_energy", "rotational_energy", "potential_energy", "elastic_energy",
-            "total_energy", "n_particles", "n_contacts",     "max_overlap_ratio", "pressure"};
+            "time",           "step",         "kinetic_energy", "rotational_energy", "potential_energy",
+            "elastic_energy", "total_energy", "n_particles",    "n_contacts",        "max_overlap_ratio",
+            "pressure",       "momentum_x",   "momentum_y"};
+        if (D == 3) columns.push_back("momentum_z");
         for (auto& c : eng_->extraColumns()) columns.push_back(c);
         flow_.emplace(sc_, world, eng_->stepTime());
         if (resume_) {
@@ -97,8 +128,10 @@ public:
         // A run killed before its end (kill -9, a node lost) leaves run.json saying so; it also proves the
         // directory writable before any time is spent.
         writeRunJson("running");
-        series_.emplace(dir_ / "series.csv", columns);
-        snaps_.emplace(dir_);
+        if (lead()) {
+            series_.emplace(dir_ / "series.csv", columns);
+            snaps_.emplace(dir_);
+        }
 
         const bool tty = opt_.progress == ProgressDisplay::On ||
                          (opt_.progress == ProgressDisplay::Auto && !opt_.quiet && isatty(STDERR_FILENO));
@@ -138,8 +171,8 @@ public:
             lastCheckpoint_ = world.time;
             log_ << "resuming from " << resume_->path.string() << " at t = " << world.time << " s\n";
         }
-        checkpoints_ = eng_->restartable();
-        if (!checkpoints_ && sc_.output.checkpointPeriod > 0)
+        checkpoints_ = eng_->restartable() && !ranks_;
+        if (!checkpoints_ && sc_.output.checkpointPeriod > 0 && lead())
             log_ << "warning: output.checkpoint_period: runs of method \"" << eng_->method()
                  << "\" write no checkpoints yet\n";
     }
@@ -181,7 +214,7 @@ public:
                     if (lastCheckpoint_ != world.time) checkpoint();
                     ckpts_.pass(world.time, eps_);
                 }
-                if (world.time + eps_ >= until || StopSignals::requested()) break;
+                if (world.time + eps_ >= until || stopAsked()) break;
                 // Inlets and outlets act at their own times (Flow::nextTime), between the engine's calls.
                 const double target = std::min(
                     {until, rows_.next(), shots_.next(), ckpts_.next(), flow_->nextTime(), measures_->nextTime()});
@@ -213,12 +246,12 @@ public:
             progress_->finish();
             stopped_ = true;
             try {
-                writeRunJson(std::string("failed: output: ") + e.what());
+                writeRunJson(std::string("failed: output: ") + e.what(), false);
             } catch (const IoError&) {
             }
             throw;
         }
-        if (!StopSignals::requested()) return !stopped_;
+        if (!stopAsked()) return !stopped_;
         noteStop();
         return false;
     }
@@ -243,18 +276,22 @@ public:
         }
         progress_->update(world.time, eng_->steps(), eng_->contacts(), true);
         progress_->finish();
-        series_->flush();
+        if (series_) series_->flush();
+        // Across ranks, the last state of every rank's particles on rank 0.
+        std::optional<World<D>> all;
+        if (ranks_) all.emplace(gathered());
+        const World<D>& last = ranks_ ? *all : world;
         // The state for a next stage (run/export.hpp): disks and spheres, unless the run blew up.
-        if (status_ != RunStatus::BlewUp && !world.particles.hasPolygons() && world.particles.hasMotion()) {
-            writeStateCsv(dir_ / "final.csv", world, sc_.materials);
-            writeLammpsData(dir_ / "final.data", world, sc_.materials);
+        if (lead() && status_ != RunStatus::BlewUp && !last.particles.hasPolygons() && last.particles.hasMotion()) {
+            writeStateCsv(dir_ / "final.csv", last, sc_.materials);
+            writeLammpsData(dir_ / "final.data", last, sc_.materials);
         }
         writeRunJson(statusText_);
-        writeFinalPicture(sc_, world, eng_->hybrid(), dir_ / "final.png");
+        if (lead()) writeFinalPicture(sc_, last, eng_->hybrid(), dir_ / "final.png");
         if (!opt_.quiet) {
             const double wall = std::chrono::duration<double>(Clock::now() - t0_).count();
             log_ << fmt::format("{} ({}): {} particles, simulated {:.4g} s in {:.2f} s wall time; outputs in {}\n",
-                                sc_.name, eng_->method(), world.particles.size(), world.time, wall, dir_.string());
+                                sc_.name, eng_->method(), last.particles.size(), world.time, wall, dir_.string());
         }
         return status_;
     }
@@ -268,7 +305,9 @@ public:
     double dt() const override { return eng_->dt(); }
     const char* method() const override { return eng_->method(); }
     const std::filesystem::path& directory() const override { return dir_; }
-    void flush() override { series_->flush(); }
+    void flush() override {
+        if (series_) series_->flush();
+    }
     void setStopScope(StopScope scope) override {
         if (scope_ == StopScope::Run || scope == StopScope::Run)
             throw std::logic_error("RunSession: the signals of `haet run` are caught for its whole life");
@@ -297,15 +336,74 @@ protected:
     }
 
 private:
+    /// Rank 0 of a run across ranks, or the one process: who writes the outputs.
+    bool lead() const { return !ranks_ || ranks_->rank() == 0; }
+
+    /// Whether the run is to stop (SIGINT, SIGTERM): across ranks, whether any rank caught one, so all stop alike.
+    bool stopAsked() const { return ranks_ ? ranks_->any(StopSignals::requested()) : StopSignals::requested(); }
+
+    /// Across ranks: a World like this rank's with every rank's own particles, on rank 0 (other ranks: none), in
+    /// order of id. Collective.
+    World<D> gathered() const {
+        const World<D>& w = *world_;
+        World<D> all;
+        all.particles = gatherParticles(*ranks_, w.particles, std::min(eng_->owned(), w.particles.size()));
+        all.domain = w.domain;
+        all.walls = w.walls;
+        all.surfaces = w.surfaces;
+        all.contact = w.contact;
+        all.time = w.time;
+        return all;
+    }
+
+    /// The particles of the run, over every rank. Collective across ranks.
+    std::size_t totalParticles() {
+        const World<D>& w = *world_;
+        if (!ranks_) return w.particles.size();
+        std::vector<double> n{double(std::min(eng_->owned(), w.particles.size())), eng_->migrated()};
+        ranks_->sum(n);
+        total_ = static_cast<std::size_t>(n[0]);
+        migrated_ = n[1];
+        return total_;
+    }
+
     std::vector<std::optional<double>> rowValues(double stamp) {
         const World<D>& world = *world_;
-        const Energies<D> e = energies(world);
-        const double elastic = eng_->elasticEnergy();
+        Energies<D> e = energies(world, eng_->owned());
+        double elastic = eng_->elasticEnergy();
         const double window = world.time - lastRowTime_;
         lastRowTime_ = world.time;
         std::optional<double> pressure;
         const double vir = eng_->virial(window);
-        if (world.domain.fullyPeriodic()) pressure = (e.mv2 + vir) / (D * world.domain.volume());
+        double contacts = double(eng_->contacts()), overlap = eng_->maxOverlapRatio();
+        double count = double(world.particles.size());
+        if (ranks_) {
+            // Sums over the ranks, each of its own particles and its share of the contacts. The pressure is left
+            // out: a pair across a boundary is in the virial of both ranks (docs/parallel.md).
+            std::vector<double> v{e.kinetic,
+                                  e.rotational,
+                                  e.potential,
+                                  e.mv2,
+                                  elastic,
+                                  eng_->contactShare(),
+                                  double(std::min(eng_->owned(), world.particles.size()))};
+            for (int k = 0; k < D; ++k) v.push_back(e.momentum[k]);
+            ranks_->sum(v);
+            e.kinetic = v[0];
+            e.rotational = v[1];
+            e.potential = v[2];
+            e.mv2 = v[3];
+            elastic = v[4];
+            contacts = std::round(v[5]);
+            count = v[6];
+            total_ = static_cast<std::size_t>(count);
+            for (int k = 0; k < D; ++k) e.momentum[k] = v[7 + k];
+            std::vector<double> worst{overlap};
+            ranks_->max(worst);
+            overlap = worst[0];
+        } else if (world.domain.fullyPeriodic()) {
+            pressure = (e.mv2 + vir) / (D * world.domain.volume());
+        }
         std::vector<std::optional<double>> row = {stamp,
                                                   double(eng_->steps()),
                                                   e.kinetic,
@@ -313,10 +411,11 @@ private:
                                                   e.potential,
                                                   elastic,
                                                   e.kinetic + e.rotational + e.potential + elastic,
-                                                  double(world.particles.size()),
-                                                  double(eng_->contacts()),
-                                                  eng_->maxOverlapRatio(),
+                                                  count,
+                                                  contacts,
+                                                  overlap,
                                                   pressure};
+        for (int k = 0; k < D; ++k) row.push_back(e.momentum[k]);
         for (auto& v : eng_->extraRow()) row.push_back(v);
         for (auto& v : flow_->row(world.time)) row.push_back(v);
         for (auto& v : measures_->row(world, contactsNow(), window)) row.push_back(v);
@@ -328,15 +427,21 @@ private:
 
     void row(double stamp) {
         eng_->synchronise();
-        series_->row(rowValues(stamp));
+        std::vector<std::optional<double>> values = rowValues(stamp);
+        if (series_) series_->row(std::move(values));
         lastRow_ = world_->time;
     }
 
     void shot(double stamp) {
         eng_->synchronise();
-        snaps_->write(*world_, stamp, eng_->hybrid());
-        measures_->snapshot(*world_, stamp, contactsNow());
-        series_->flush();
+        if (ranks_) {  // gathered on rank 0, one file as from one process (docs/parallel.md)
+            const World<D> all = gathered();
+            if (lead()) snaps_->write(all, stamp, nullptr);
+        } else {
+            snaps_->write(*world_, stamp, eng_->hybrid());
+            measures_->snapshot(*world_, stamp, contactsNow());
+        }
+        if (series_) series_->flush();
         lastShot_ = world_->time;
     }
 
@@ -400,8 +505,11 @@ private:
         return encodeCheckpoint(h, body.bytes());
     }
 
-    void writeRunJson(const std::string& status) {
+    /// run.json (rank 0). count: count the particles over the ranks first (collective), else the last count.
+    void writeRunJson(const std::string& status, bool count = true) {
         const World<D>& world = *world_;
+        const std::size_t particles = ranks_ ? (count ? totalParticles() : total_) : world.particles.size();
+        if (!lead()) return;
         const double wall = std::chrono::duration<double>(Clock::now() - t0_).count();
         JsonObject j;
         j.add("version", kVersion);
@@ -435,7 +543,12 @@ private:
             j.add("picture", pic);
         }
         j.add("status", status);
-        j.add("n_particles", world.particles.size());
+        j.add("n_particles", particles);
+        if (ranks_) {
+            j.add("ranks", static_cast<std::int64_t>(ranks_->size()));
+            j.add("migrated", static_cast<std::uint64_t>(
+                                  migrated_));  // particles handed from one rank's slab to another's, over the run
+        }
         j.add("contact_time", world.contact.contactTime);
         j.add("simulated_time", world.time);
         j.add("steps", eng_->steps());
@@ -454,7 +567,7 @@ private:
             j.add("checkpoints", c);
         }
         j.add("wall_time", wall);
-        j.add("particle_steps_per_second", wall > 0 ? double(eng_->steps()) * world.particles.size() / wall : 0.0);
+        j.add("particle_steps_per_second", wall > 0 ? double(eng_->steps()) * particles / wall : 0.0);
         j.add("threads", static_cast<std::int64_t>(omp_get_max_threads()));
         j.add("peak_rss_bytes", peakRssBytes());
         writeFileAtomic(dir_ / "run.json", j.dump() + "\n");
@@ -471,6 +584,9 @@ private:
     std::optional<World<D>> world_;
     std::optional<StopSignals> signals_;  // StopScope::Run: for the session's life
     int stopSignal_ = 0;                  // the signal that stopped it (0: none)
+    Ranks* ranks_ = nullptr;              // across ranks (more than one); null in one process
+    std::size_t total_ = 0;               // across ranks: the particles over all ranks at the last count
+    double migrated_ = 0;                 // across ranks: the migrations over all ranks at the last count
     std::unique_ptr<Driver<D>> eng_;
     RunPlan plan_;
     std::optional<Flow<D>> flow_;

@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "tdm/halo.hpp"
+
 namespace haet {
 
 template <int D>
@@ -19,6 +21,7 @@ TdmEngine<D>::TdmEngine(World<D>& world, const TdmSettings& s) : w_(world), s_(s
         verlet_ = vv.get();
         integ_ = std::move(vv);
     }
+    if (s.ranks && s.ranks->size() > 1) scatterToSlabs();
     wallHistory_.assign(w_.particles.tdmCount() * w_.walls.size(), Vec<D>::zero());
     surf_.setWalls(&w_.surfaces);
     for (const SurfaceWall<D>& wall : w_.surfaces) staticSurfaces_ = staticSurfaces_ && !wall.motion.moves();
@@ -92,6 +95,10 @@ void TdmEngine<D>::computeForces(bool correct, std::atomic<bool>* nextMoved) {
 
 template <int D>
 void TdmEngine<D>::rebuild(bool sort) {
+    if (halo_) {
+        rebuildAcrossRanks(sort);
+        return;
+    }
     Particles<D>& p = w_.particles;
     const std::size_t n = p.tdmCount();
     wrapPositions(p, w_.domain);
@@ -224,7 +231,7 @@ typename TdmEngine<D>::WallLoad TdmEngine<D>::planeLoad(std::size_t w) const {
     const Particles<D>& p = w_.particles;
     const Wall<D>& wall = w_.walls[w];
     const std::size_t nw = w_.walls.size();
-    for (std::size_t i = 0; i < p.tdmCount(); ++i) {
+    for (std::size_t i = 0; i < owned(); ++i) {
         const Vec<D>& f = planeForce_[i * nw + w];
         if (f == Vec<D>::zero()) continue;
         const Vec<D> at = p.x[i] - wall.normal * wall.distanceNow(p.x[i]);  // the contact point on the plane
@@ -343,8 +350,11 @@ void TdmEngine<D>::contactCounts(std::vector<std::uint8_t>& out) const {
 
 template <int D>
 void TdmEngine<D>::step() {
-    const bool moved = integ_->predict(w_.particles, s_.dt, motion_, xAtBuild_.data(), driftLimit2());
+    bool moved = integ_->predict(w_.particles, s_.dt, motion_, xAtBuild_.data(), driftLimit2());
+    bool stop = false;
+    if (halo_) agree(moved, stop);
     finishStep(moved, nullptr);
+    if (halo_) agree(moved, stop);  // this step's health, agreed before step() returns
 }
 
 template <int D>
@@ -356,14 +366,23 @@ void TdmEngine<D>::finishStep(bool moved, std::atomic<bool>* nextMoved) {
     moveWalls();
     if (moved) {
         rebuild(s_.sortEvery > 0 && steps_ - lastSort_ >= static_cast<std::uint64_t>(s_.sortEvery));
-        checkSpeeds();  // O(N) beside the O(N) rebuild; a system that blows up rebuilds at every step
+        // O(N) beside the O(N) rebuild; a system that blows up rebuilds at every step
+        if (halo_)
+            check([&] { checkSpeeds(); });
+        else
+            checkSpeeds();
+    } else if (halo_) {
+        refreshGhosts();
     }
     // The contact network's step (recordContactsAt): one test of a pointer in every other step.
     if (recordSink_ && std::abs(w_.time - recordTime_) < 0.5 * s_.dt) [[unlikely]]
         recordNow_ = recordSink_;
     computeForces(true, nextMoved);
     if (recordNow_) recorded();
-    checkHealth();
+    if (halo_)
+        check([&] { checkHealth(); });
+    else
+        checkHealth();
 }
 
 template <int D>
@@ -402,13 +421,19 @@ void TdmEngine<D>::advanceTo(double t) {
         if (!predicted) moved = integ_->predict(w_.particles, s_.dt, motion_, xAtBuild_.data(), driftLimit2());
         // After this step, whether another one follows in this call; a stop asked for ends the call after it, so
         // the state is never left holding the next step's prediction.
-        const bool stop = s_.stop && s_.stop->load(std::memory_order_relaxed);
+        bool stop = s_.stop && s_.stop->load(std::memory_order_relaxed);
+        if (halo_) agree(moved, stop);  // every rank rebuilds, and stops, at the same step
         const bool more = !stop && timeAfter(1) + 0.5 * s_.dt <= t;
         predicted = fuse && more;
         std::atomic<bool> nextMoved{false};
         finishStep(moved, predicted ? &nextMoved : nullptr);
         moved = nextMoved.load(std::memory_order_relaxed);
         if (stop) break;
+    }
+    // The last step's health, agreed before the call returns (the moved and stop bits are not used).
+    if (halo_) {
+        bool stop = false;
+        agree(moved, stop);
     }
 }
 
@@ -451,6 +476,7 @@ void TdmEngine<D>::checkSpeeds() const {
 
 template <int D>
 double TdmEngine<D>::contactEnergy() const {
+    if (halo_) return contactEnergyShare();
     const ForceContext<D> ctx = context(motion_.v.data(), motion_.w.data());
     if constexpr (D == 2)
         if (shapes_) return shapes_->energy(ctx);

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "contact/kinds.hpp"
@@ -13,6 +14,7 @@
 #include "tdm/contact_record.hpp"
 #include "tdm/forces.hpp"
 #include "tdm/integrators.hpp"
+#include "tdm/ranks.hpp"
 #include "tdm/shape_pass.hpp"
 #include "tdm/surface_state.hpp"
 #include "world/world.hpp"
@@ -31,6 +33,9 @@ struct TdmSettings {
     bool markPlanes = true;
     /// Set from outside (a signal handler: run/stop.hpp) to end advanceTo after the step under way; null: never.
     const std::atomic<bool>* stop = nullptr;
+    /// A run across several ranks (tdm/ranks.hpp, docs/parallel.md): each keeps the particles of its slab and ghost
+    /// copies of its neighbours'; null (or one rank): every particle here. Velocity Verlet, disks and spheres, planes.
+    Ranks* ranks = nullptr;
 };
 
 template <int D>
@@ -53,6 +58,16 @@ public:
     std::uint64_t rebuilds() const { return rebuilds_; }
     const ForceStats& forceStats() const { return stats_; }
     const PairList<D>& pairs() const { return pairs_; }
+    /// Particles [0, owned()) are this rank's; across ranks the ghosts follow them. One process: tdmCount().
+    std::size_t owned() const { return halo_ ? nOwned_ : w_.particles.tdmCount(); }
+    /// Across ranks: the slabs as they are now (null in one process).
+    const Slabs* slabs() const;
+    /// Across ranks: the particles this rank handed to another's slab so far, and the re-placements of the cuts.
+    std::uint64_t migrated() const;
+    std::uint64_t rebalances() const;
+    /// This rank's share of the contacts now: a pair with a ghost counts one half (its owner's rank counts the
+    /// other), wall contacts those of the owned particles. One process: the last force pass's count.
+    double contactShare() const;
 
     /// After the particles in [0, tdmCount()) changed (a hybrid moved some in or out): new particle k was old
     /// particle from[k], or is new to this engine (kFresh). Per-particle history follows; a new particle starts
@@ -83,7 +98,7 @@ public:
     /// or a checkpoint's state came after the constructor.
     bool recordStartContacts(ContactSink<D>* sink);
 
-    /// Elastic energy stored in contacts (pairs and walls) [J].
+    /// Elastic energy stored in contacts (pairs and walls) [J]; across ranks this rank's share, as contactShare().
     double contactEnergy() const;
     /// Sum over contacts of r_ij . F_ij [J] (pair virial; walls excluded).
     double pairVirial() const;
@@ -122,6 +137,18 @@ private:
     /// The drift beyond which the pair list is rebuilt, squared: (skin / 2)^2.
     double driftLimit2() const { return 0.25 * s_.skin * s_.skin; }
     void rebuild(bool sort);
+    // Across ranks (tdm/ranks.cpp): the first cut into slabs, the rebuild that migrates particles with their springs
+    // and makes the ghosts anew, the ghosts' state after every other prediction, and the ranks' agreement, after each
+    // prediction, on whether to rebuild and stop and on whether a health check failed on any rank since the last
+    // agreement (then every rank throws its SimulationError): one collective a step. check runs a health check,
+    // keeping its failure for the agreement.
+    void scatterToSlabs();
+    void rebuildAcrossRanks(bool sort);
+    void refreshGhosts();
+    void agree(bool& moved, bool& stop);
+    template <class Check>
+    void check(Check run);
+    double contactEnergyShare() const;
     /// Planes and walls of any shape to the current time; the candidates rebuilt if a wall moved too far.
     void moveWalls();
     /// The broad phase of walls of any shape at the current poses, the elements within each particle's radius plus
@@ -161,7 +188,11 @@ private:
     ContactSink<D>* recordSink_ = nullptr;  ///< recordContactsAt
     ContactSink<D>* recordNow_ = nullptr;   ///< the sink, during the force pass that records
     double recordTime_ = 0, recordedAt_ = -1;
-    bool pristine_ = true;  ///< nothing since the constructor's force pass (recordStartContacts)
+    bool pristine_ = true;        ///< nothing since the constructor's force pass (recordStartContacts)
+    struct Halo;                  ///< across ranks: the slabs, the ghosts and who sends them (tdm/halo.hpp)
+    std::unique_ptr<Halo> halo_;  ///< null in one process
+    std::size_t nOwned_ = 0;      ///< across ranks: particles [0, nOwned_) are this rank's, the rest ghosts
+    std::string failure_;         ///< across ranks: a health check's failure since the last agreement
 };
 
 }  // namespace haet
