@@ -54,3 +54,15 @@ run() {
     CPU=$(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.2f", u + s }')
     WALL=$wall
 }
+
+# chute_args SCRIPT BUILD_DIR [3d|2d]: the arguments of a script on the chute of bench/lammps/; sets build (the
+# build directory, absolute) and case (3d by default, or 2d); exits 2 with the usage otherwise.
+chute_args() {
+    local script=$1
+    shift
+    [ $# -ge 1 ] && [ $# -le 2 ] || { echo "usage: $script BUILD_DIR [3d|2d]" >&2; exit 2; }
+    case=${2:-3d}
+    case $case in 3d|2d) ;; *) echo "usage: $script BUILD_DIR [3d|2d]" >&2; exit 2 ;; esac
+    [ -d "$1" ] || { echo "$script: build directory not found: $1" >&2; exit 2; }
+    build=$(cd "$1" && pwd)
+}

@@ -16,16 +16,11 @@
 # 1 a run failed, 2 usage.
 set -euo pipefail
 
-usage() { echo "usage: $0 BUILD_DIR [3d|2d]" >&2; exit 2; }
-[ $# -ge 1 ] && [ $# -le 2 ] || usage
-case=${2:-3d}
-case $case in 3d|2d) ;; *) usage ;; esac
-[ -d "$1" ] || { echo "$0: build directory not found: $1" >&2; exit 2; }
-build=$(cd "$1" && pwd)
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 root=$(cd "$here/.." && pwd)
 # shellcheck source=bench/lib.sh
 . "$here/lib.sh"
+chute_args "$0" "$@"
 STEPS=${STEPS:-5000}
 ROUNDS=${ROUNDS:-3}
 LMP=${LMP:-lmp}
