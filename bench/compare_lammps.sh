@@ -21,14 +21,11 @@
 #              CSV rows). Exit status: 0 all measured; 1 a half failed (the other is still reported); 2 usage.
 set -euo pipefail
 
-usage() { echo "usage: $0 BUILD_DIR [3d|2d]" >&2; exit 2; }
-[ $# -ge 1 ] && [ $# -le 2 ] || usage
-case=${2:-3d}
-case $case in 3d|2d) ;; *) usage ;; esac
-[ -d "$1" ] || { echo "$0: build directory not found: $1" >&2; exit 2; }
-build=$(cd "$1" && pwd)
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 root=$(cd "$here/.." && pwd)
+# shellcheck source=bench/lib.sh
+. "$here/lib.sh"
+chute_args "$0" "$@"
 data=$here/data
 name=chute$case
 runs=$data/runs/$name
@@ -38,8 +35,6 @@ HAET_THREADS=${HAET_THREADS:-1 2}
 LMP=${LMP:-lmp}
 IDLE_STEPS=10
 haet=$build/haet
-# shellcheck source=bench/lib.sh
-. "$here/lib.sh"
 machine=${MACHINE:-$(machine_name)}
 csv=$here/results/$machine/lammps_chute.csv
 status=0
